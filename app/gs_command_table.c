@@ -1,0 +1,10 @@
+// gs_command_table.c: the subcommands gaitsim knows, in the order --help lists them.
+#include <stddef.h>
+
+#include "app/gs_commands.h"
+
+const gsCommand gs_commands[] = {
+    {"run", gs_cmd_run, "run the default pipeline on the bundled trial"},
+    {"info", gs_cmd_info, "summarise a model: degrees of freedom, muscles, contacts, mass"},
+    {NULL, NULL, NULL},
+};

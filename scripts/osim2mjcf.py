@@ -1,0 +1,1237 @@
+#!/usr/bin/python3
+"""osim2mjcf.py: convert the Knee Grand Challenge JW OpenSim model to MJCF for MuJoCo 2.2.2.
+
+Reads JW_AllBody_scaled.osim (OpenSim 4.0 document format, gait2392-family muscles) and the
+muscle_params folder, writes one MJCF file that follows callbacks/gs_model_layout.h, and a
+reference table of muscle-tendon lengths and moment arms computed from the OpenSim geometry
+alone (CustomJoint kinematics, path points incl. conditional and moving points, straight
+segments, no wrapping) for the project's C test.
+
+Standard library only. Deterministic: the same inputs give the same bytes.
+
+Usage:
+  /usr/bin/python3 scripts/osim2mjcf.py --osim PATH --muscle-params DIR \
+      --out mjmodels/jw_fullbody.xml --reference-out mjmodels/reference/jw_moment_arms.csv \
+      [--trial-ik PATH]
+"""
+import argparse
+import csv
+import math
+import os
+import xml.etree.ElementTree as ET
+
+CONVERTER = "scripts/osim2mjcf.py"
+
+# ------------------------------------------------------------------------------------------------
+# model decisions (documented in mjmodels/README.md)
+# ------------------------------------------------------------------------------------------------
+
+# the 26 generalized coordinates of the MuJoCo model, in qpos order (pelvis first)
+MODEL_COORDINATES = [
+    "pelvis_tx", "pelvis_ty", "pelvis_tz", "pelvis_rz", "pelvis_rx", "pelvis_ry",
+    "hip_flexion", "hip_adduction", "hip_rotation",
+    "knee_flexion", "knee_adduction", "knee_rotation", "knee_tx", "knee_ty", "knee_tz",
+    "ankle_angle", "subtalar_angle",
+    "hip_flexion_l", "hip_adduction_l", "hip_rotation_l", "knee_flexion_l",
+    "ankle_angle_l", "subtalar_angle_l",
+    "lumbar_extension", "lumbar_bending", "lumbar_rotation",
+]
+
+# secondary right-knee coordinates: placeholder springs until a knee-contact model replaces them
+KNEE_SECONDARY = {
+    # name: (stiffness N m/rad or N/m, damping N m s/rad or N s/m)
+    "knee_adduction": (1.0e4, 50.0),
+    "knee_rotation": (1.0e4, 50.0),
+    "knee_tx": (1.0e6, 2.0e3),
+    "knee_ty": (1.0e6, 2.0e3),
+    "knee_tz": (1.0e6, 2.0e3),
+}
+
+# locked coordinates of the welded arms: arms down, elbows 15 deg flexed (rad)
+ARM_POSE = {
+    "arm_flex_r": 0.0, "arm_add_r": 0.0, "arm_rot_r": 0.0, "elbow_flex_r": math.radians(15.0),
+    "wrist_flex_r": 0.0, "wrist_dev_r": 0.0,
+    "arm_flex_l": 0.0, "arm_add_l": 0.0, "arm_rot_l": 0.0, "elbow_flex_l": math.radians(15.0),
+    "wrist_flex_l": 0.0, "wrist_dev_l": 0.0,
+}
+
+# duplicate paths in the .osim that are left out (same muscle with a shorter path or unscaled)
+SKIPPED_FORCES = {
+    "recfem_withreallength", "vasint_withreallength", "vaslat_withreallength",
+    "vasmed_withreallength",
+    "ercspn_r_0", "ercspn_l_0", "intobl_r_0", "intobl_l_0", "extobl_r_0", "extobl_l_0",
+}
+
+# JW right-leg muscle names -> gait2392 names (to look up the metabolic parameters)
+GAIT2392_NAME = {
+    "addbrev": "add_brev", "addlong": "add_long", "addmagProx": "add_mag1",
+    "addmagMid": "add_mag2", "addmagDist": "add_mag3", "addmagIsch": "add_mag3",
+    "bflh": "bifemlh", "bfsh": "bifemsh", "edl": "ext_dig", "ehl": "ext_hal",
+    "fdl": "flex_dig", "fhl": "flex_hal", "gaslat": "lat_gas", "gasmed": "med_gas", "gem": "gem",
+    "glmax1": "glut_max1", "glmax2": "glut_max2", "glmax3": "glut_max3",
+    "glmed1": "glut_med1", "glmed2": "glut_med2", "glmed3": "glut_med3",
+    "glmin1": "glut_min1", "glmin2": "glut_min2", "glmin3": "glut_min3",
+    "grac": "grac", "iliacus": "iliacus", "pect": "pect", "perbrev": "per_brev",
+    "perlong": "per_long", "pertert": "per_tert", "piri": "peri", "psoas": "psoas",
+    "quadfem": "quad_fem", "recfem": "rect_fem", "sart": "sar", "semimem": "semimem",
+    "semiten": "semiten", "soleus": "soleus", "tfl": "tfl", "tibant": "tib_ant",
+    "tibpost": "tib_post", "vasint": "vas_int", "vaslat": "vas_lat", "vasmed": "vas_med",
+}
+
+MUSCLE_DENSITY = 1059.7   # kg/m^3 (Umberger et al. 2003)
+VMAX = 10.0               # lopt/s
+TAU_ACT = 0.010           # s
+TAU_DEACT = 0.040         # s
+TENDON_KT = 35.0          # De Groote et al. 2016 tendon shape factor (-)
+
+# Hunt-Crossley sphere parameters (geom user row, gs_model_layout.h order)
+CONTACT_USER = [1.0e6, 2.0, 0.8, 0.8, 0.5, 0.2]
+# contact spheres in the calcaneus frame (m), right foot; z is mirrored for the left foot.
+# Adapted from antoinefalisse/3dpredictsim (Falisse et al. 2019) to JW's foot; 5-6 go on the toes.
+CONTACT_SPHERES = [
+    # (index, x, y, z, radius)
+    (1, 0.0019, -0.0100, -0.0038, 0.032),
+    (2, 0.1484, -0.0100, -0.0287, 0.032),
+    (3, 0.1330, -0.0100, 0.0516, 0.032),
+    (4, 0.0662, -0.0100, 0.0265, 0.032),
+    (5, 0.2366, -0.0120, -0.0188, 0.020),
+    (6, 0.2216, -0.0120, 0.0602, 0.020),
+]
+
+EPS_ZERO = 1e-8           # |default value| below which a coordinate default counts as 0
+FD_STEP = 1e-5            # central-difference step for moment arms (rad or m)
+
+
+# ------------------------------------------------------------------------------------------------
+# 3-D rigid transforms: rotation matrices as 3x3 nested lists, transforms as (R, p)
+# ------------------------------------------------------------------------------------------------
+
+def mat_mul(a, b):
+    return [[sum(a[i][k] * b[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
+
+
+def mat_vec(a, v):
+    return [sum(a[i][k] * v[k] for k in range(3)) for i in range(3)]
+
+
+def mat_t(a):
+    return [[a[j][i] for j in range(3)] for i in range(3)]
+
+
+def vec_add(a, b):
+    return [a[i] + b[i] for i in range(3)]
+
+
+def vec_sub(a, b):
+    return [a[i] - b[i] for i in range(3)]
+
+
+def vec_scale(a, s):
+    return [x * s for x in a]
+
+
+def vec_norm(a):
+    return math.sqrt(sum(x * x for x in a))
+
+
+def unit(a):
+    n = vec_norm(a)
+    return [x / n for x in a]
+
+
+IDENTITY = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]
+TF_IDENTITY = (IDENTITY, [0.0, 0.0, 0.0])
+
+
+def axis_angle(axis, angle):
+    """Rotation matrix of a right-handed rotation by angle (rad) about the unit axis (Rodrigues)."""
+    x, y, z = axis
+    c, s = math.cos(angle), math.sin(angle)
+    t = 1.0 - c
+    return [[t * x * x + c, t * x * y - s * z, t * x * z + s * y],
+            [t * x * y + s * z, t * y * y + c, t * y * z - s * x],
+            [t * x * z - s * y, t * y * z + s * x, t * z * z + c]]
+
+
+def body_fixed_xyz(angles):
+    """OpenSim frame orientation: body-fixed X-Y-Z Euler angles (rad), R = Rx Ry Rz."""
+    r = axis_angle([1.0, 0.0, 0.0], angles[0])
+    r = mat_mul(r, axis_angle([0.0, 1.0, 0.0], angles[1]))
+    return mat_mul(r, axis_angle([0.0, 0.0, 1.0], angles[2]))
+
+
+def tf_mul(a, b):
+    """Compose frames: X_AC = X_AB * X_BC."""
+    return (mat_mul(a[0], b[0]), vec_add(mat_vec(a[0], b[1]), a[1]))
+
+
+def tf_inv(a):
+    rt = mat_t(a[0])
+    return (rt, vec_scale(mat_vec(rt, a[1]), -1.0))
+
+
+def tf_point(a, p):
+    return vec_add(mat_vec(a[0], p), a[1])
+
+
+def tf_rot(r):
+    return (r, [0.0, 0.0, 0.0])
+
+
+def tf_trans(p):
+    return (IDENTITY, list(p))
+
+
+def quat_from_mat(r):
+    """Unit quaternion (w x y z), w >= 0, of a rotation matrix."""
+    tr = r[0][0] + r[1][1] + r[2][2]
+    if tr > 0.0:
+        s = math.sqrt(tr + 1.0) * 2.0
+        q = [0.25 * s, (r[2][1] - r[1][2]) / s, (r[0][2] - r[2][0]) / s, (r[1][0] - r[0][1]) / s]
+    elif r[0][0] > r[1][1] and r[0][0] > r[2][2]:
+        s = math.sqrt(1.0 + r[0][0] - r[1][1] - r[2][2]) * 2.0
+        q = [(r[2][1] - r[1][2]) / s, 0.25 * s, (r[0][1] + r[1][0]) / s, (r[0][2] + r[2][0]) / s]
+    elif r[1][1] > r[2][2]:
+        s = math.sqrt(1.0 + r[1][1] - r[0][0] - r[2][2]) * 2.0
+        q = [(r[0][2] - r[2][0]) / s, (r[0][1] + r[1][0]) / s, 0.25 * s, (r[1][2] + r[2][1]) / s]
+    else:
+        s = math.sqrt(1.0 + r[2][2] - r[0][0] - r[1][1]) * 2.0
+        q = [(r[1][0] - r[0][1]) / s, (r[0][2] + r[2][0]) / s, (r[1][2] + r[2][1]) / s, 0.25 * s]
+    if q[0] < 0.0:
+        q = [-x for x in q]
+    n = math.sqrt(sum(x * x for x in q))
+    return [x / n for x in q]
+
+
+# ------------------------------------------------------------------------------------------------
+# OpenSim functions (Function.h family): LinearFunction, Constant, MultiplierFunction, SimmSpline
+# ------------------------------------------------------------------------------------------------
+
+class LinearFunction:
+    """OpenSim LinearFunction: f(x) = a x + b, coefficients 'a b'."""
+    def __init__(self, a, b):
+        self.a, self.b = a, b
+
+    def __call__(self, x):
+        return self.a * x + self.b
+
+
+class ConstantFunction:
+    def __init__(self, value):
+        self.value = value
+
+    def __call__(self, x):
+        return self.value
+
+
+class MultiplierFunction:
+    """OpenSim MultiplierFunction: f(x) = scale * g(x) (written by model scaling)."""
+    def __init__(self, inner, scale):
+        self.inner, self.scale = inner, scale
+
+    def __call__(self, x):
+        return self.scale * self.inner(x)
+
+
+class SimmSpline:
+    """OpenSim SimmSpline: the Forsythe-Malcolm-Moler cubic spline (end conditions from cubics
+    through the first and last four points), linear extrapolation with the end slopes
+    (OpenSim SimmSpline::calcCoefficients, SimmSpline::calcValue)."""
+    def __init__(self, xs, ys):
+        self.x, self.y = list(xs), list(ys)
+        n = len(xs)
+        b, c, d = [0.0] * n, [0.0] * n, [0.0] * n
+        x, y = self.x, self.y
+        if n == 2:
+            b[0] = b[1] = (y[1] - y[0]) / (x[1] - x[0])
+        elif n >= 3:
+            nm1 = n - 1
+            d[0] = x[1] - x[0]
+            c[1] = (y[1] - y[0]) / d[0]
+            for i in range(1, nm1):
+                d[i] = x[i + 1] - x[i]
+                b[i] = 2.0 * (d[i - 1] + d[i])
+                c[i + 1] = (y[i + 1] - y[i]) / d[i]
+                c[i] = c[i + 1] - c[i]
+            b[0] = -d[0]
+            b[nm1] = -d[n - 2]
+            c[0] = c[nm1] = 0.0
+            if n > 3:
+                c[0] = c[2] / (x[3] - x[1]) - c[1] / (x[2] - x[0])
+                c[nm1] = c[n - 2] / (x[nm1] - x[n - 3]) - c[n - 3] / (x[n - 2] - x[n - 4])
+                c[0] = c[0] * d[0] * d[0] / (x[3] - x[0])
+                c[nm1] = -c[nm1] * d[n - 2] * d[n - 2] / (x[nm1] - x[n - 4])
+            for i in range(1, n):
+                t = d[i - 1] / b[i - 1]
+                b[i] -= t * d[i - 1]
+                c[i] -= t * c[i - 1]
+            c[nm1] /= b[nm1]
+            for j in range(nm1):
+                i = n - 2 - j
+                c[i] = (c[i] - d[i] * c[i + 1]) / b[i]
+            b[nm1] = (y[nm1] - y[n - 2]) / d[n - 2] + d[n - 2] * (c[n - 2] + 2.0 * c[nm1])
+            for i in range(nm1):
+                b[i] = (y[i + 1] - y[i]) / d[i] - d[i] * (c[i + 1] + 2.0 * c[i])
+                d[i] = (c[i + 1] - c[i]) / d[i]
+                c[i] = 3.0 * c[i]
+            c[nm1] = 3.0 * c[nm1]
+            d[nm1] = d[n - 2]
+        self.b, self.c, self.d = b, c, d
+
+    def __call__(self, xv):
+        x, y = self.x, self.y
+        n = len(x)
+        if n == 1:
+            return y[0]
+        if xv < x[0]:
+            return y[0] + (xv - x[0]) * self.b[0]
+        if xv > x[-1]:
+            return y[-1] + (xv - x[-1]) * self.b[-1]
+        k = 0
+        while k < n - 2 and xv >= x[k + 1]:
+            k += 1
+        dx = xv - x[k]
+        return y[k] + dx * (self.b[k] + dx * (self.c[k] + dx * self.d[k]))
+
+
+def floats(text):
+    return [float(v) for v in text.split()]
+
+
+def parse_function(elem):
+    """Build a callable from an OpenSim Function element."""
+    tag = elem.tag
+    if tag == "LinearFunction":
+        a, b = floats(elem.findtext("coefficients"))
+        return LinearFunction(a, b)
+    if tag == "Constant":
+        return ConstantFunction(float(elem.findtext("value")))
+    if tag == "MultiplierFunction":
+        inner = parse_function(elem.find("function")[0])
+        return MultiplierFunction(inner, float(elem.findtext("scale")))
+    if tag == "SimmSpline":
+        return SimmSpline(floats(elem.findtext("x")), floats(elem.findtext("y")))
+    raise ValueError("unsupported OpenSim function " + tag)
+
+
+# ------------------------------------------------------------------------------------------------
+# OpenSim model: bodies, joints (with offset frames), coordinates, couplers, muscles
+# ------------------------------------------------------------------------------------------------
+
+def last_name(path):
+    """'/bodyset/femur' -> 'femur', '/jointset/knee_l/knee_flexion_l' -> 'knee_flexion_l'."""
+    return path.strip().split("/")[-1]
+
+
+class OsimModel:
+    def __init__(self, path):
+        root = ET.parse(path).getroot()
+        model = root.find("Model")
+        self.bodies = {}
+        self.body_order = []
+        for b in model.find("BodySet/objects"):
+            wraps = []
+            for w in b.find("WrapObjectSet/objects"):
+                wraps.append({
+                    "name": w.get("name"), "type": w.tag,
+                    "rotation": body_fixed_xyz(floats(w.findtext("xyz_body_rotation"))),
+                    "translation": floats(w.findtext("translation")),
+                    "quadrant": (w.findtext("quadrant") or "all").strip(),
+                    "radius": float(w.findtext("radius") or 0.0),
+                    "length": float(w.findtext("length") or 0.0),
+                    "dimensions": floats(w.findtext("dimensions") or "0 0 0"),
+                })
+            self.bodies[b.get("name")] = {
+                "mass": float(b.findtext("mass")),
+                "com": floats(b.findtext("mass_center")),
+                "inertia": floats(b.findtext("inertia")),
+                "wraps": wraps,
+            }
+            self.body_order.append(b.get("name"))
+        self.coords = {}
+        self.joints = []
+        for j in model.find("JointSet/objects"):
+            frames = {}
+            for f in j.findall("frames/PhysicalOffsetFrame"):
+                frames[f.get("name")] = (
+                    last_name(f.findtext("socket_parent")),
+                    (body_fixed_xyz(floats(f.findtext("orientation"))),
+                     floats(f.findtext("translation"))))
+            parent_body, parent_offset = frames[j.findtext("socket_parent_frame").strip()]
+            child_body, child_offset = frames[j.findtext("socket_child_frame").strip()]
+            axes = []
+            for ta in j.findall("SpatialTransform/TransformAxis"):
+                fn = [e for e in ta if e.tag not in ("coordinates", "axis")][0]
+                axes.append({
+                    "kind": "rotation" if ta.get("name").startswith("rotation") else "translation",
+                    "axis": unit(floats(ta.findtext("axis"))),
+                    "coordinate": (ta.findtext("coordinates") or "").strip() or None,
+                    "function": parse_function(fn),
+                })
+            for c in j.findall("coordinates/Coordinate"):
+                self.coords[c.get("name")] = {
+                    "default": float(c.findtext("default_value")),
+                    "range": floats(c.findtext("range")),
+                    "locked": c.findtext("locked").strip() == "true",
+                    "joint": j.get("name"),
+                }
+            self.joints.append({
+                "name": j.get("name"), "type": j.tag,
+                "parent": parent_body, "parent_offset": parent_offset,
+                "child": child_body, "child_offset": child_offset,
+                "rotations": [a for a in axes if a["kind"] == "rotation"],
+                "translations": [a for a in axes if a["kind"] == "translation"],
+            })
+        self.couplers = {}
+        for c in model.find("ConstraintSet/objects"):
+            if c.tag == "CoordinateCouplerConstraint" and c.findtext("isEnforced").strip() == "true":
+                fn = parse_function(c.find("coupled_coordinates_function")[0])
+                self.couplers[c.findtext("dependent_coordinate_name").strip()] = (
+                    c.findtext("independent_coordinate_names").strip(), fn,
+                    float(c.findtext("scale_factor") or 1.0))
+        self.muscles = []
+        for f in model.find("ForceSet/objects"):
+            if f.find("max_isometric_force") is None or f.get("name") in SKIPPED_FORCES:
+                continue
+            points = []
+            for p in f.find("GeometryPath/PathPointSet/objects"):
+                pt = {"name": p.get("name"), "type": p.tag,
+                      "body": last_name(p.findtext("socket_parent_frame"))}
+                if p.tag == "MovingPathPoint":
+                    pt["coords"] = [last_name(p.findtext("socket_%s_coordinate" % a))
+                                    for a in "xyz"]
+                    pt["functions"] = [parse_function(p.find("%s_location" % a)[0])
+                                       for a in "xyz"]
+                else:
+                    pt["location"] = floats(p.findtext("location"))
+                if p.tag == "ConditionalPathPoint":
+                    pt["coordinate"] = last_name(p.findtext("socket_coordinate"))
+                    pt["range"] = floats(p.findtext("range"))
+                points.append(pt)
+            wraps = []
+            for w in f.findall("GeometryPath/PathWrapSet/objects/PathWrap"):
+                wraps.append({"object": w.findtext("wrap_object").strip(),
+                              "range": [int(v) for v in floats(w.findtext("range") or "-1 -1")]})
+            self.muscles.append({
+                "name": f.get("name"), "type": f.tag, "points": points, "wraps": wraps,
+                "fmax": float(f.findtext("max_isometric_force")),
+                "lopt": float(f.findtext("optimal_fiber_length")),
+                "lts": float(f.findtext("tendon_slack_length")),
+                "pennation": float(f.findtext("pennation_angle_at_optimal")),
+            })
+        self._memo = {}
+        self.build_tree()
+
+    def build_tree(self):
+        """Spanning tree from ground. A joint whose child body is already placed is reversed,
+        as OpenSim 4's MultibodyGraphMaker does; the joint still states X_G,pf * X_FM = X_G,cf."""
+        placed = {"ground"}
+        self.tree = []          # (joint, reversed) in an order where parents come first
+        self.tree_parent = {}   # body -> tree parent body
+        self.tree_edge = {}     # body -> (joint, reversed) that places it
+        remaining = list(self.joints)
+        while remaining:
+            progress = False
+            for j in list(remaining):
+                if j["parent"] in placed and j["child"] not in placed:
+                    child, parent, rev = j["child"], j["parent"], False
+                elif j["child"] in placed and j["parent"] not in placed:
+                    child, parent, rev = j["parent"], j["child"], True
+                else:
+                    continue
+                placed.add(child)
+                self.tree.append((j, rev))
+                self.tree_parent[child] = parent
+                self.tree_edge[child] = (j, rev)
+                remaining.remove(j)
+                progress = True
+            if not progress:
+                raise ValueError("joints do not form a tree: %s" % [j["name"] for j in remaining])
+
+    # --- coordinate values -------------------------------------------------------------------
+
+    def default_value(self, name):
+        v = self.coords[name]["default"]
+        return 0.0 if abs(v) < EPS_ZERO else v
+
+    def coordinate_values(self, independent):
+        """All coordinate values from the model's independent ones: couplers (enforced
+        CoordinateCouplerConstraint: q_dep = f(q_indep)), welded arms, locked defaults."""
+        values = {}
+        for name in self.coords:
+            if name in independent:
+                values[name] = independent[name]
+            elif name in ARM_POSE:
+                values[name] = ARM_POSE[name]
+            else:
+                values[name] = self.default_value(name)
+        for dep, (indep, fn, scale) in self.couplers.items():
+            values[dep] = scale * fn(values[indep])
+        return values
+
+    # --- CustomJoint kinematics -------------------------------------------------------------
+
+    @staticmethod
+    def joint_transform(joint, values):
+        """X_FM of a CustomJoint SpatialTransform (OpenSim SpatialTransform /
+        Simbody MobilizedBody::FunctionBased): R_FM = R(axis1,f1) R(axis2,f2) R(axis3,f3), each
+        rotation about the axis of the frame produced by the previous ones (body-fixed), and
+        p_FM = sum f_i axis_i of the three translations, expressed in F."""
+        r = IDENTITY
+        for ax in joint["rotations"]:
+            q = values[ax["coordinate"]] if ax["coordinate"] else 0.0
+            r = mat_mul(r, axis_angle(ax["axis"], ax["function"](q)))
+        p = [0.0, 0.0, 0.0]
+        for ax in joint["translations"]:
+            q = values[ax["coordinate"]] if ax["coordinate"] else 0.0
+            p = vec_add(p, vec_scale(ax["axis"], ax["function"](q)))
+        return (r, p)
+
+    def pose_state(self, independent):
+        """(all coordinate values, body transforms) of a pose, memoised by pose."""
+        key = tuple(sorted(independent.items()))
+        if key not in self._memo:
+            if len(self._memo) > 20000:
+                self._memo.clear()
+            values = self.coordinate_values(independent)
+            self._memo[key] = (values, self.body_transforms(values))
+        return self._memo[key]
+
+    def body_transforms(self, values):
+        """X_G,B of every body (OpenSim ground frame, Y up)."""
+        x = {"ground": TF_IDENTITY}
+        for j, rev in self.tree:
+            xfm = self.joint_transform(j, values)
+            if not rev:
+                x_gf = tf_mul(x[j["parent"]], j["parent_offset"])
+                x[j["child"]] = tf_mul(tf_mul(x_gf, xfm), tf_inv(j["child_offset"]))
+            else:
+                x_gm = tf_mul(x[j["child"]], j["child_offset"])
+                x[j["parent"]] = tf_mul(tf_mul(x_gm, tf_inv(xfm)), tf_inv(j["parent_offset"]))
+        return x
+
+
+# ------------------------------------------------------------------------------------------------
+# muscle paths without wrapping (reference geometry)
+# ------------------------------------------------------------------------------------------------
+
+def point_is_active(pt, values):
+    """ConditionalPathPoint: active while range[0] <= q <= range[1] (OpenSim ConditionalPathPoint)."""
+    if pt["type"] != "ConditionalPathPoint":
+        return True
+    q = values[pt["coordinate"]]
+    return pt["range"][0] <= q <= pt["range"][1]
+
+
+def point_location(pt, values):
+    """Location in the point's body frame; MovingPathPoint: (fx(qx), fy(qy), fz(qz))."""
+    if pt["type"] == "MovingPathPoint":
+        return [fn(values[c]) for fn, c in zip(pt["functions"], pt["coords"])]
+    return pt["location"]
+
+
+def path_length(model, muscle, independent):
+    values, x = model.pose_state(independent)
+    pts = [tf_point(x[p["body"]], point_location(p, values))
+           for p in muscle["points"] if point_is_active(p, values)]
+    return sum(vec_norm(vec_sub(pts[i + 1], pts[i])) for i in range(len(pts) - 1))
+
+
+def crossed_coordinates(model, muscle):
+    """Model coordinates of the joints between the bodies the path attaches to."""
+    def chain(body):
+        out = []
+        while body != "ground":
+            out.append(body)
+            body = model.tree_parent[body]
+        return out
+    chains = [chain(p["body"]) for p in muscle["points"]]
+    common = set(chains[0])
+    for c in chains[1:]:
+        common &= set(c)
+    bodies = set()
+    for c in chains:
+        bodies |= set(c) - common
+    names = set()
+    for b in bodies:
+        j, _ = model.tree_edge[b]
+        for ax in j["rotations"] + j["translations"]:
+            if ax["coordinate"] in MODEL_COORDINATES:
+                names.add(ax["coordinate"])
+        # coupled coordinates move with their independent coordinate
+        for ax in j["rotations"] + j["translations"]:
+            if ax["coordinate"] in model.couplers:
+                indep = model.couplers[ax["coordinate"]][0]
+                if indep in MODEL_COORDINATES:
+                    names.add(indep)
+    return [c for c in MODEL_COORDINATES if c in names]
+
+
+def moment_arms(model, muscle, pose, coordinates):
+    """r = -dL/dq by central differences (h = FD_STEP)."""
+    out = {}
+    for c in coordinates:
+        lo, hi = dict(pose), dict(pose)
+        lo[c] -= FD_STEP
+        hi[c] += FD_STEP
+        out[c] = -(path_length(model, muscle, hi) - path_length(model, muscle, lo)) / (2 * FD_STEP)
+    return out
+
+
+# ------------------------------------------------------------------------------------------------
+# trial poses (IK of ngait_og5, degrees and m)
+# ------------------------------------------------------------------------------------------------
+
+def read_trial(path):
+    with open(path) as f:
+        rows = [r for r in csv.reader(line for line in f if not line.startswith("#"))]
+    header = rows[0]
+    frames = []
+    for r in rows[1:]:
+        rec = dict(zip(header, (float(v) for v in r)))
+        pose = {}
+        for c in MODEL_COORDINATES:
+            v = rec[c]
+            pose[c] = v if c in ("pelvis_tx", "pelvis_ty", "pelvis_tz", "knee_tx", "knee_ty",
+                                 "knee_tz") else math.radians(v)
+        frames.append((rec["time"], pose))
+    return frames
+
+
+def reference_poses(frames):
+    """Five poses spanning the right knee/hip range: the frames at 0, 20, 40, 60, 80 % of the
+    trial duration, the extremes of right knee flexion and of right hip flexion (frame indices
+    are written in the pose table)."""
+    n = len(frames)
+    idx = [int(round(k * (n - 1) / 5.0)) for k in range(5)]
+    knee = [f[1]["knee_flexion"] for f in frames]
+    hip = [f[1]["hip_flexion"] for f in frames]
+    for extra in (knee.index(min(knee)), knee.index(max(knee)), hip.index(min(hip)),
+                  hip.index(max(hip))):
+        if extra not in idx:
+            idx.append(extra)
+    return sorted(idx)
+
+
+# ------------------------------------------------------------------------------------------------
+# MJCF body tree: OpenSim joint -> MuJoCo body pos/quat + joints
+# ------------------------------------------------------------------------------------------------
+
+def joint_ops(model, joint, reversed_):
+    """The frame from the tree parent body to the tree child body as a product of fixed
+    transforms and single-axis motions, in order. Forward: X_P,pf * Trans(p(q)) * R1 R2 R3 *
+    inv(X_C,cf). Reversed: X_C,cf * inv(X_FM) * inv(X_P,pf) = X_C,cf * R3^T R2^T R1^T *
+    Trans(-p(q)) * inv(X_P,pf). Motions: (kind, axis, coordinate, function, sign)."""
+    ops = []
+    rot = [("hinge", a["axis"], a["coordinate"], a["function"], 1.0) for a in joint["rotations"]]
+    tra = [("slide", a["axis"], a["coordinate"], a["function"], 1.0)
+           for a in joint["translations"]]
+    if not reversed_:
+        ops.append(("fixed", joint["parent_offset"]))
+        ops += tra + rot
+        ops.append(("fixed", tf_inv(joint["child_offset"])))
+    else:
+        ops.append(("fixed", joint["child_offset"]))
+        ops += [(k, ax, c, f, -1.0) for (k, ax, c, f, _) in reversed(rot)]
+        ops += [(k, ax, c, f, -1.0) for (k, ax, c, f, _) in tra]
+        ops.append(("fixed", tf_inv(joint["parent_offset"])))
+    return ops
+
+
+def motion_transform(kind, axis, amount):
+    if kind == "hinge":
+        return tf_rot(axis_angle(axis, amount))
+    return tf_trans(vec_scale(axis, amount))
+
+
+def mujoco_body_frame(model, joint, reversed_, values):
+    """Split the ops into MuJoCo's form B0 * J'_1(q1 - ref1) * J'_2 ...: every coordinate that is
+    not a model coordinate, and each model coordinate's reference value, goes into the fixed
+    part; each motion J_i is conjugated by the fixed transforms that follow it,
+    J'_i = M_i^-1 J_i M_i (axis R_Mi^T a, anchor -R_Mi^T p_Mi in the body frame)."""
+    seq = []   # ("fixed", tf) | ("motion", kind, axis, coordinate, slope)
+    for op in joint_ops(model, joint, reversed_):
+        if op[0] == "fixed":
+            seq.append(op)
+            continue
+        kind, axis, coord, fn, sign = op
+        q = values[coord] if coord else 0.0
+        if coord in MODEL_COORDINATES:
+            if not isinstance(fn, LinearFunction) or abs(abs(fn.a) - 1.0) > 1e-12:
+                raise ValueError("model coordinate %s must map through f(q) = +-q + b" % coord)
+            seq.append(("fixed", motion_transform(kind, axis, sign * fn(q))))
+            seq.append(("motion", kind, vec_scale(axis, sign * fn.a), coord))
+        else:
+            amount = sign * fn(q)
+            if abs(amount) > 0.0:
+                seq.append(("fixed", motion_transform(kind, axis, amount)))
+    b0 = TF_IDENTITY
+    for s in seq:
+        if s[0] == "fixed":
+            b0 = tf_mul(b0, s[1])
+    joints = []
+    for i, s in enumerate(seq):
+        if s[0] != "motion":
+            continue
+        m = TF_IDENTITY
+        for t in seq[i + 1:]:
+            if t[0] == "fixed":
+                m = tf_mul(m, t[1])
+        rt = mat_t(m[0])
+        joints.append({"kind": s[1], "coordinate": s[3], "axis": mat_vec(rt, s[2]),
+                       "anchor": vec_scale(mat_vec(rt, m[1]), -1.0)})
+    return b0, joints
+
+
+# ------------------------------------------------------------------------------------------------
+# formatting
+# ------------------------------------------------------------------------------------------------
+
+def fmt(v, digits=8):
+    """Shortest stable decimal for v (deterministic, no '-0')."""
+    s = "%.*g" % (digits, v)
+    if float(s) == 0.0:
+        return "0"
+    return s
+
+
+def fvec(vs, digits=8):
+    return " ".join(fmt(v, digits) for v in vs)
+
+
+def clean_axis(a):
+    return [0.0 if abs(x) < 1e-12 else x for x in a]
+
+
+# ------------------------------------------------------------------------------------------------
+# muscle path -> MuJoCo sites and wrap geoms
+# ------------------------------------------------------------------------------------------------
+
+def fit_moving_point(model, muscle, k, frames):
+    """Fixed point in the MovingPathPoint's body that best reproduces the muscle's length and
+    moment arms over the trial frames: Gauss-Newton on the 3 coordinates of the point, residuals
+    = length error and moment-arm error about the point's coordinate (m)."""
+    pt = muscle["points"][k]
+    coord = pt["coords"][0]
+    samples = frames[::6]
+    # start from the mean location over the trial
+    locs = []
+    for _, pose in samples:
+        locs.append(point_location(pt, model.coordinate_values(pose)))
+    start = [sum(l[i] for l in locs) / len(locs) for i in range(3)]
+
+    fixed = dict(muscle)
+    fixed_points = list(muscle["points"])
+
+    def make(loc):
+        p = {"name": pt["name"], "type": "PathPoint", "body": pt["body"], "location": loc}
+        pts = list(fixed_points)
+        pts[k] = p
+        f = dict(fixed)
+        f["points"] = pts
+        return f
+
+    targets = []
+    for _, pose in samples:
+        targets.append((pose, path_length(model, muscle, pose),
+                        moment_arms(model, muscle, pose, [coord])[coord]))
+
+    def residuals(loc):
+        f = make(loc)
+        res = []
+        for pose, l_ref, r_ref in targets:
+            res.append(path_length(model, f, pose) - l_ref)
+            res.append(moment_arms(model, f, pose, [coord])[coord] - r_ref)
+        return res
+
+    # Levenberg-Marquardt on (x, y); z (out of the sagittal plane) stays at its mean: the
+    # length and the flexion moment arm hardly depend on it
+    def cost(res):
+        return sum(v * v for v in res)
+
+    loc = list(start)
+    r0 = residuals(loc)
+    lam = 1e-6
+    for _ in range(30):
+        jac = []
+        for i in range(2):
+            d = list(loc)
+            d[i] += 1e-6
+            ri = residuals(d)
+            jac.append([(ri[n] - r0[n]) / 1e-6 for n in range(len(r0))])
+        a = [[sum(jac[i][n] * jac[j][n] for n in range(len(r0))) for j in range(2)]
+             for i in range(2)]
+        g = [-sum(jac[i][n] * r0[n] for n in range(len(r0))) for i in range(2)]
+        while True:
+            a00, a11 = a[0][0] * (1 + lam), a[1][1] * (1 + lam)
+            det = a00 * a11 - a[0][1] * a[1][0]
+            step = [(g[0] * a11 - a[0][1] * g[1]) / det, (a00 * g[1] - a[1][0] * g[0]) / det]
+            trial = [loc[0] + step[0], loc[1] + step[1], loc[2]]
+            rt = residuals(trial)
+            if cost(rt) < cost(r0):
+                loc, r0, lam = trial, rt, lam * 0.3
+                break
+            lam *= 10.0
+            if lam > 1e6:
+                return loc
+        if math.hypot(step[0], step[1]) < 1e-8:
+            break
+    return loc
+
+
+def solve3(a, b):
+    det = (a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+           - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+           + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0]))
+    out = []
+    for col in range(3):
+        m = [row[:] for row in a]
+        for r in range(3):
+            m[r][col] = b[r]
+        out.append((m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+                    - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+                    + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])) / det)
+    return out
+
+
+def conditional_kept(pt, frames):
+    """Keep a ConditionalPathPoint if it is active in at least half of the trial frames."""
+    active = sum(1 for _, pose in frames
+                 if pt["range"][0] <= pose.get(pt["coordinate"], 0.0) <= pt["range"][1])
+    return 2 * active >= len(frames)
+
+
+def wrap_geom_spec(body, w):
+    """MuJoCo wrap geom for an OpenSim wrap object. WrapCylinder -> cylinder (axis local z, as in
+    OpenSim); WrapSphere -> sphere; WrapEllipsoid -> cylinder along the longest semi-axis with the
+    mean of the two others as radius (sphere with the mean radius if the axes differ < 20 %)."""
+    rot = w["rotation"]
+    if w["type"] == "WrapCylinder":
+        return {"type": "cylinder", "radius": w["radius"], "half": w["length"] / 2.0, "rot": rot}
+    if w["type"] == "WrapSphere":
+        return {"type": "sphere", "radius": w["radius"], "half": 0.0, "rot": rot}
+    dims = w["dimensions"]
+    if max(dims) < 1.2 * min(dims):
+        return {"type": "sphere", "radius": sum(dims) / 3.0, "half": 0.0, "rot": rot}
+    k = dims.index(max(dims))
+    others = [dims[i] for i in range(3) if i != k]
+    # rotate so that the cylinder's local z is the ellipsoid's axis k
+    to_z = {0: [[0, 0, 1], [0, 1, 0], [-1, 0, 0]],   # columns: new x,y,z in ellipsoid frame
+            1: [[1, 0, 0], [0, 0, 1], [0, -1, 0]],
+            2: IDENTITY}[k]
+    return {"type": "cylinder", "radius": sum(others) / 2.0, "half": dims[k],
+            "rot": mat_mul(rot, to_z), "axis_index": k}
+
+
+def quadrant_direction(w):
+    """Unit direction (wrap-object frame) of OpenSim's quadrant, None for 'all'."""
+    q = w["quadrant"].lower()
+    if q in ("all", ""):
+        return None
+    sign = -1.0 if q.startswith("-") else 1.0
+    k = "xyz".index(q[-1])
+    d = [0.0, 0.0, 0.0]
+    d[k] = sign
+    return d
+
+
+def assign_wraps(model, muscle, kept_points, x0):
+    """For each PathWrap choose the path segment (between two kept points) it acts on: within the
+    PathWrap's point range, the segment passing closest to the wrap centre at the default pose.
+    Returns {segment index: (wrap object body, wrap object)}; one wrap per segment."""
+    wrap_objects = {}
+    for b in model.body_order:
+        for w in model.bodies[b]["wraps"]:
+            wrap_objects[w["name"]] = (b, w)
+    best = {}
+    for pw in muscle["wraps"]:
+        body, w = wrap_objects[pw["object"]]
+        centre = tf_point(x0[body], w["translation"])
+        lo, hi = pw["range"]
+        choices = []
+        for s in range(len(kept_points) - 1):
+            i0, i1 = kept_points[s][0], kept_points[s + 1][0]
+            if lo > 0 and not (i0 + 1 >= lo and i1 + 1 <= hi):
+                continue
+            a = tf_point(x0[kept_points[s][1]["body"]], kept_points[s][2])
+            b = tf_point(x0[kept_points[s + 1][1]["body"]], kept_points[s + 1][2])
+            ab = vec_sub(b, a)
+            t = max(0.0, min(1.0, sum((centre[i] - a[i]) * ab[i] for i in range(3))
+                             / max(1e-12, sum(v * v for v in ab))))
+            dist = vec_norm(vec_sub(centre, vec_add(a, vec_scale(ab, t))))
+            choices.append((dist, s))
+        if not choices:
+            continue
+        dist, s = min(choices)
+        if s not in best or dist < best[s][0]:
+            best[s] = (dist, body, w)
+    return {s: (v[1], v[2]) for s, v in best.items()}
+
+
+# ------------------------------------------------------------------------------------------------
+# the converter
+# ------------------------------------------------------------------------------------------------
+
+def read_metabolic(path):
+    out = {}
+    with open(path) as f:
+        rows = list(csv.DictReader(line for line in f if not line.startswith("#")))
+    for r in rows:
+        out[r["muscle"]] = (float(r["pct_slow_twitch"]), float(r["specific_tension_MPa"]) * 1e6)
+    return out
+
+
+def metabolic_key(name):
+    """JW muscle name -> row of the 3dpredictsim table (right-leg rows serve both legs)."""
+    if name in ("ercspn_r", "ercspn_l", "intobl_r", "intobl_l", "extobl_r", "extobl_l"):
+        return name
+    if name.endswith("_l"):
+        return name[:-2] + "_r"
+    return GAIT2392_NAME[name] + "_r"
+
+
+class Converter:
+    def __init__(self, model, metabolic, frames, osim_name):
+        self.model = model
+        self.metabolic = metabolic
+        self.frames = frames
+        self.osim_name = osim_name
+        # reference (default) pose: OpenSim defaults of the knee's secondary coordinates, 0 else
+        self.defaults = {c: model.default_value(c) if c in KNEE_SECONDARY else 0.0
+                         for c in MODEL_COORDINATES}
+        self.values0 = model.coordinate_values(self.defaults)
+        self.x0 = model.body_transforms(self.values0)
+        self.children = {}
+        for j, rev in model.tree:
+            child = j["parent"] if rev else j["child"]
+            parent = j["child"] if rev else j["parent"]
+            self.children.setdefault(parent, []).append((child, j, rev))
+        self.sites = {}          # body -> [(site name, pos)]
+        self.wrap_geoms = {}     # body -> [wrap geom spec]
+        self.tendons = []        # (muscle, [elements])
+        self.notes = {"moving": [], "conditional": [], "dropped_wraps": []}
+
+    # --- bodies ------------------------------------------------------------------------------
+
+    def relocated_body(self, body):
+        """Patella bodies follow the knee through coupler constraints that make them rigid with
+        the tibia (patfem_flexion = knee_flexion + 1.57 about the same femoral axis, other patfem
+        coordinates locked): they become jointless children of the tibia-side body."""
+        return {"patella": "tibial_tray", "patella_l": "tibia_l"}.get(body)
+
+    def build_paths(self):
+        m = self.model
+        for mus in m.muscles:
+            kept = []
+            for i, p in enumerate(mus["points"]):
+                if p["type"] == "ConditionalPathPoint":
+                    keep = conditional_kept(p, self.frames)
+                    self.notes["conditional"].append((mus["name"], p["name"], p["coordinate"],
+                                                      p["range"], keep))
+                    if not keep:
+                        continue
+                if p["type"] == "MovingPathPoint":
+                    loc = fit_moving_point(m, mus, i, self.frames)
+                    self.notes["moving"].append((mus["name"], p["name"], loc))
+                else:
+                    loc = p["location"]
+                kept.append((i, p, loc))
+            elements = []
+            seg_wraps = assign_wraps(m, mus, kept, self.x0)
+            for wp in mus["wraps"]:
+                if wp["object"] not in [w["name"] for (_, w) in seg_wraps.values()]:
+                    self.notes["dropped_wraps"].append((mus["name"], wp["object"]))
+            for s, (i, p, loc) in enumerate(kept):
+                site = "%s-P%d" % (mus["name"], i + 1)
+                self.sites.setdefault(p["body"], []).append((site, loc))
+                elements.append(("site", site))
+                if s in seg_wraps:
+                    body, w = seg_wraps[s]
+                    geom = self.wrap_geom_name(body, w)
+                    side = self.side_site(body, w)
+                    elements.append(("geom", geom, side))
+            self.tendons.append((mus, elements))
+
+    def wrap_geom_name(self, body, w):
+        lst = self.wrap_geoms.setdefault(body, [])
+        if w["name"] not in [x["name"] for x in lst]:
+            spec = wrap_geom_spec(body, w)
+            spec["name"] = w["name"]
+            spec["pos"] = w["translation"]
+            spec["quadrant"] = quadrant_direction(w)
+            spec["orig_rot"] = w["rotation"]
+            lst.append(spec)
+        return w["name"]
+
+    def side_site(self, body, w):
+        """Sidesite outside the wrap surface in OpenSim's quadrant direction (none for 'all')."""
+        d = quadrant_direction(w)
+        if d is None:
+            return None
+        spec = [x for x in self.wrap_geoms[body] if x["name"] == w["name"]][0]
+        reach = 1.5 * max(spec["radius"], max(w["dimensions"]) if w["type"] == "WrapEllipsoid"
+                          else spec["radius"])
+        pos = tf_point((w["rotation"], w["translation"]), vec_scale(d, reach))
+        name = w["name"] + "_side"
+        lst = self.sites.setdefault(body, [])
+        if name not in [s[0] for s in lst]:
+            lst.append((name, pos))
+        return name
+
+    # --- writing -----------------------------------------------------------------------------
+
+    def emit_body(self, out, body, j, rev, indent):
+        m = self.model
+        pad = "  " * indent
+        b0, joints = mujoco_body_frame(m, j, rev, self.values0)
+        out.append('%s<body name="%s" pos="%s" quat="%s">' % (
+            pad, body, fvec(b0[1]), fvec(quat_from_mat(b0[0]))))
+        for jt in joints:
+            out.append(pad + "  " + self.joint_xml(jt))
+        self.emit_body_content(out, body, indent + 1)
+        for child, cj, crev in self.children.get(body, []):
+            if self.relocated_body(child):
+                continue
+            self.emit_body(out, child, cj, crev, indent + 1)
+        for moved, host in (("patella", "tibial_tray"), ("patella_l", "tibia_l")):
+            if host == body:
+                rel = tf_mul(tf_inv(self.x0[body]), self.x0[moved])
+                out.append('%s  <body name="%s" pos="%s" quat="%s">' % (
+                    pad, moved, fvec(rel[1]), fvec(quat_from_mat(rel[0]))))
+                self.emit_body_content(out, moved, indent + 2)
+                out.append(pad + "  </body>")
+        out.append(pad + "</body>")
+
+    def joint_xml(self, jt):
+        c = jt["coordinate"]
+        rng = self.model.coords[c]["range"]
+        axis = clean_axis(jt["axis"])
+        attrs = ['name="%s"' % c, 'type="%s"' % jt["kind"], 'axis="%s"' % fvec(axis)]
+        if jt["kind"] == "hinge" and vec_norm(jt["anchor"]) > 1e-12:
+            attrs.append('pos="%s"' % fvec(clean_axis(jt["anchor"])))
+        ref = self.defaults[c]
+        if ref != 0.0:
+            attrs.append('ref="%s"' % fmt(ref))
+        if not c.startswith("pelvis"):
+            attrs.append('range="%s"' % fvec(rng))
+        else:
+            attrs.append('limited="false"')
+        if c in KNEE_SECONDARY:
+            k, d = KNEE_SECONDARY[c]
+            attrs.append('stiffness="%s" springref="%s" damping="%s"' % (fmt(k), fmt(ref), fmt(d)))
+        return "<joint %s/>" % " ".join(attrs)
+
+    def emit_body_content(self, out, body, indent):
+        pad = "  " * indent
+        b = self.model.bodies[body]
+        ixx, iyy, izz, ixy, ixz, iyz = b["inertia"]
+        if b["mass"] > 0.0:
+            if ixy == 0.0 and ixz == 0.0 and iyz == 0.0:
+                inert = 'diaginertia="%s"' % fvec([ixx, iyy, izz])
+            else:
+                inert = 'fullinertia="%s"' % fvec([ixx, iyy, izz, ixy, ixz, iyz])
+            out.append('%s<inertial pos="%s" mass="%s" %s/>' % (pad, fvec(b["com"]),
+                                                                fmt(b["mass"], 12), inert))
+        for spec in self.wrap_geoms.get(body, []):
+            size = fmt(spec["radius"]) if spec["type"] == "sphere" else \
+                "%s %s" % (fmt(spec["radius"]), fmt(max(spec["half"], spec["radius"])))
+            out.append('%s<geom name="%s" class="wrap" type="%s" size="%s" pos="%s" quat="%s"/>'
+                       % (pad, spec["name"], spec["type"], size, fvec(spec["pos"]),
+                          fvec(quat_from_mat(spec["rot"]))))
+        for name, pos in self.sites.get(body, []):
+            cls = "side" if name.endswith("_side") else "path"
+            out.append('%s<site name="%s" class="%s" pos="%s"/>' % (pad, name, cls, fvec(pos)))
+        for side, calc, toes in (("r", "calcaneus", "toes"), ("l", "calcaneus_l", "toes_l")):
+            if body not in (calc, toes):
+                continue
+            for k, x, y, z, r in CONTACT_SPHERES:
+                on_toes = k >= 5
+                if (body == toes) != on_toes:
+                    continue
+                p = [x, y, z if side == "r" else -z]
+                if on_toes:
+                    p = tf_point(tf_mul(tf_inv(self.x0[toes]), self.x0[calc]), p)
+                out.append('%s<geom name="contact_%s_%d" class="contact" size="%s" pos="%s"/>'
+                           % (pad, side, k, fmt(r), fvec(p, 6)))
+
+    def standing_height(self):
+        """pelvis_ty that puts the lowest contact sphere on the floor (all else at default)."""
+        lowest = None
+        for calc, toes, zs in (("calcaneus", "toes", 1.0), ("calcaneus_l", "toes_l", -1.0)):
+            for k, x, y, z, r in CONTACT_SPHERES:
+                p = tf_point(self.x0[calc], [x, y, zs * z])
+                h = p[1] - r
+                lowest = h if lowest is None else min(lowest, h)
+        return -lowest
+
+    def lengthranges(self):
+        out = {}
+        for mus in self.model.muscles:
+            ls = [path_length(self.model, mus, pose) for _, pose in self.frames[::4]]
+            lo, hi = min(ls), max(ls)
+            span = max(hi - lo, 0.01)
+            out[mus["name"]] = (max(0.01, lo - 0.5 * span), hi + 0.5 * span)
+        return out
+
+    def actuator_user(self, mus):
+        st, sigma = self.metabolic[metabolic_key(mus["name"])]
+        mass = mus["fmax"] / sigma * mus["lopt"] * MUSCLE_DENSITY
+        return [mus["fmax"], mus["lopt"], mus["lts"], mus["pennation"], VMAX, st, sigma, mass,
+                1.0 if mus["lts"] >= mus["lopt"] else 0.0, TAU_ACT, TAU_DEACT, TENDON_KT]
+
+    def write(self, path):
+        m = self.model
+        self.build_paths()
+        total_mass = sum(b["mass"] for b in m.bodies.values())
+        out = []
+        out.append('<?xml version="1.0" encoding="utf-8"?>')
+        out.append("<!--")
+        out.append("  jw_fullbody.xml: GENERATED by %s, do not edit by hand; regenerate with" % CONVERTER)
+        out.append("    /usr/bin/python3 scripts/osim2mjcf.py --osim .../JW_AllBody_scaled.osim \\")
+        out.append("      --muscle-params .../muscle_params --out mjmodels/jw_fullbody.xml \\")
+        out.append("      --reference-out mjmodels/reference/jw_moment_arms.csv")
+        out.append("  Source: %s from gilserrancoli/ReducePoly_forMSK (MIT licence)," % self.osim_name)
+        out.append("    Knee Grand Challenge subject JW (right TKA, instrumented eTibia),")
+        out.append("    Fregly et al. 2012, J Orthop Res 30:503. Metabolic muscle parameters:")
+        out.append("    antoinefalisse/3dpredictsim (MIT), Uchida et al. 2016.")
+        out.append("  %d DOF (hinge/slide only), %d muscles, total mass %s kg." % (
+            len(MODEL_COORDINATES), len(m.muscles), fmt(total_mass, 6)))
+        out.append("  Frames: body 'ground' rotates OpenSim's Y-up ground (X forward, Y up, Z right)")
+        out.append("    into MuJoCo's Z-up world (+90 deg about X): OpenSim Y -> world Z,")
+        out.append("    OpenSim Z -> world -Y. Coordinate values mean what they mean in OpenSim.")
+        out.append("  Layout of actuator and geom user rows: callbacks/gs_model_layout.h;")
+        out.append("    choices and errors: mjmodels/README.md.")
+        out.append("-->")
+        out.append('<mujoco model="jw_fullbody">')
+        out.append('  <compiler angle="radian" autolimits="true" balanceinertia="true">')
+        out.append('    <lengthrange useexisting="true" mode="muscle"/>')
+        out.append("  </compiler>")
+        out.append('  <option timestep="0.001" gravity="0 0 -9.80665" integrator="Euler"/>')
+        out.append('  <size nuser_actuator="12" nuser_geom="6"/>')
+        out.append("  <default>")
+        out.append('    <joint armature="0" damping="0"/>')
+        out.append('    <geom contype="0" conaffinity="0" group="1"/>')
+        out.append('    <site size="0.004" group="4"/>')
+        out.append('    <default class="wrap">')
+        out.append('      <geom contype="0" conaffinity="0" group="3" rgba="0.3 0.8 0.8 0.3"/>')
+        out.append("    </default>")
+        out.append('    <default class="path"><site size="0.003" rgba="0.8 0.2 0.2 1"/></default>')
+        out.append('    <default class="side"><site size="0.002" rgba="0.2 0.8 0.2 1"/></default>')
+        out.append('    <default class="contact">')
+        out.append('      <geom type="sphere" contype="1" conaffinity="1" group="2" condim="3"'
+                   ' friction="0.8 0.005 0.0001" rgba="0.9 0.6 0.2 1" user="%s"/>'
+                   % fvec(CONTACT_USER))
+        out.append("    </default>")
+        out.append('    <tendon width="0.002" rgba="0.7 0.1 0.1 1"/>')
+        out.append("  </default>")
+        out.append("  <worldbody>")
+        out.append('    <geom name="floor" type="plane" size="10 5 0.1" contype="1" conaffinity="1"'
+                   ' group="0" rgba="0.8 0.8 0.8 1"/>')
+        out.append('    <light name="sun" pos="0 0 4" dir="0 0 -1" directional="true"/>')
+        out.append('    <body name="ground" quat="%s">' % fvec(quat_from_mat(
+            axis_angle([1.0, 0.0, 0.0], math.pi / 2.0))))
+        for child, j, rev in self.children["ground"]:
+            self.emit_body(out, child, j, rev, 3)
+        out.append("    </body>")
+        out.append("  </worldbody>")
+        out.append("  <tendon>")
+        for mus, elements in self.tendons:
+            out.append('    <spatial name="%s">' % mus["name"])
+            for e in elements:
+                if e[0] == "site":
+                    out.append('      <site site="%s"/>' % e[1])
+                elif e[2]:
+                    out.append('      <geom geom="%s" sidesite="%s"/>' % (e[1], e[2]))
+                else:
+                    out.append('      <geom geom="%s"/>' % e[1])
+            out.append("    </spatial>")
+        out.append("  </tendon>")
+        out.append("  <actuator>")
+        ranges = self.lengthranges()
+        for mus in m.muscles:
+            lr = ranges[mus["name"]]
+            out.append('    <muscle name="%s" tendon="%s" force="%s" lengthrange="%s" '
+                       'range="0.75 1.05" user="%s"/>' % (
+                           mus["name"], mus["name"], fmt(mus["fmax"]), fvec(lr, 6),
+                           fvec(self.actuator_user(mus))))
+        out.append("  </actuator>")
+        qpos = []
+        for c in MODEL_COORDINATES:
+            qpos.append(self.standing_height() if c == "pelvis_ty" else self.defaults[c])
+        out.append("  <keyframe>")
+        out.append('    <key name="standing" qpos="%s"/>' % fvec(qpos))
+        out.append("  </keyframe>")
+        out.append("</mujoco>")
+        write_text(path, "\n".join(out) + "\n")
+
+
+def write_text(path, text):
+    """Write to a temporary name and rename: a crash never leaves half a file."""
+    d = os.path.dirname(path)
+    if d:
+        os.makedirs(d, exist_ok=True)
+    tmp = path + ".tmp"
+    with open(tmp, "w", newline="\n") as f:
+        f.write(text)
+    os.replace(tmp, path)
+
+
+def write_reference(model, frames, path, poses_path, osim_name, trial_name):
+    idx = reference_poses(frames)
+    lines = []
+    lines.append("# GENERATED by %s (do not edit): muscle-tendon lengths and moment arms of %s"
+                 % (CONVERTER, osim_name))
+    lines.append("# (gilserrancoli/ReducePoly_forMSK, MIT; Knee Grand Challenge subject JW, "
+                 "Fregly et al. 2012 J Orthop Res 30:503) computed from the OpenSim geometry only:")
+    lines.append("# CustomJoint kinematics incl. reversed joints and coupler constraints, path points "
+                 "incl. conditional and moving points evaluated exactly, straight segments, NO wrapping.")
+    lines.append("# Poses: frames of %s listed in jw_poses.csv. value: length (m) or moment arm "
+                 "r = -dL/dq (m) by central differences, h = %g." % (trial_name, FD_STEP))
+    lines.append("# wraps = 1 if the OpenSim path has wrap objects. MuJoCo actuator_moment = dL/dq = -r.")
+    lines.append("pose,muscle,coordinate,value,wraps")
+    pose_lines = ["# GENERATED by %s: reference poses for jw_moment_arms.csv, frames of %s; "
+                  "radians and m, model coordinate order" % (CONVERTER, trial_name),
+                  "# pose: trial row (0-based), time (s): " + "; ".join(
+                      "%d: %d, %s" % (k, i, fmt(frames[i][0])) for k, i in enumerate(idx)),
+                  "pose," + ",".join(MODEL_COORDINATES)]
+    for k, i in enumerate(idx):
+        t, pose = frames[i]
+        pose_lines.append("%d,%s" % (k, ",".join(fmt(pose[c], 10) for c in MODEL_COORDINATES)))
+        for mus in model.muscles:
+            wraps = 1 if mus["wraps"] else 0
+            lines.append("%d,%s,length,%s,%d" % (k, mus["name"],
+                                                fmt(path_length(model, mus, pose), 10), wraps))
+            crossed = crossed_coordinates(model, mus)
+            for c, r in moment_arms(model, mus, pose, crossed).items():
+                lines.append("%d,%s,%s,%s,%d" % (k, mus["name"], c, fmt(r, 8), wraps))
+    write_text(path, "\n".join(lines) + "\n")
+    write_text(poses_path, "\n".join(pose_lines) + "\n")
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--osim", required=True)
+    ap.add_argument("--muscle-params", required=True)
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--reference-out", required=True)
+    ap.add_argument("--trial-ik", default=None,
+                    help="IK csv (default: <osim dir>/../ngait_og5/IK_ngait_og5.csv)")
+    args = ap.parse_args()
+    trial = args.trial_ik or os.path.join(os.path.dirname(os.path.abspath(args.osim)), "..",
+                                          "ngait_og5", "IK_ngait_og5.csv")
+    model = OsimModel(args.osim)
+    frames = read_trial(trial)
+    metabolic = read_metabolic(os.path.join(args.muscle_params,
+                                            "MTparameters_subject1_with_metabolic_params.csv"))
+    conv = Converter(model, metabolic, frames, os.path.basename(args.osim))
+    conv.write(args.out)
+    write_reference(model, frames, args.reference_out,
+                    os.path.join(os.path.dirname(args.reference_out), "jw_poses.csv"),
+                    os.path.basename(args.osim), os.path.basename(trial))
+    print("wrote %s (%d dof, %d muscles, %.4f kg) and %s" % (
+        args.out, len(MODEL_COORDINATES), len(model.muscles),
+        sum(b["mass"] for b in model.bodies.values()), args.reference_out))
+
+
+if __name__ == "__main__":
+    main()

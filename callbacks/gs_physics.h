@@ -1,0 +1,64 @@
+// gs_physics.h: gaitsim's physics inside MuJoCo. This is the one file that installs mjcb_*.
+//
+// MuJoCo computes the multibody dynamics; gaitsim adds through MuJoCo's callbacks what MuJoCo
+// lacks (DESIGN.md, "Contacts are ours"):
+//   mjcb_act_dyn    first-order activation dynamics of each Hill muscle (gs_activation.h)
+//   mjcb_act_gain   Hill muscle-tendon force (gs_muscle.h): rigid tendons from fibre kinematics,
+//   mjcb_act_bias   elastic tendons from the normalised tendon force state in d->userdata
+//   mjcb_passive    smooth Hunt-Crossley foot-ground contact of every contact sphere
+//                   (gs_contact.h), applied to qfrc_passive; MuJoCo's own contacts are disabled
+// Callbacks are pure functions of (m, d, i): every parameter comes from the model
+// (gs_model_layout.h), every per-evaluation state from d (d->userdata). They are thread-safe with
+// one mjData per thread.
+//
+// Per-evaluation muscle state (d->userdata, GS_USERDATA_SIZE(m) doubles):
+//   userdata[i], i < nu   normalised tendon force f~T = F_T / Fmax of actuator i   (-)
+//                         (elastic-tendon muscles; ignored for the others)
+#ifndef GAITSIM_CALLBACKS_GS_PHYSICS_H_
+#define GAITSIM_CALLBACKS_GS_PHYSICS_H_
+
+#include <mujoco/mujoco.h>
+
+#include "callbacks/gs_contact.h"
+#include "callbacks/gs_muscle.h"
+
+// doubles of d->userdata the physics uses
+#define GS_USERDATA_SIZE(m) ((m)->nu)
+
+// Switch model m to gaitsim's physics: gaitsim muscles get user gain, bias and dynamics; MuJoCo's
+// contact solver is disabled (the spheres become ours); nuserdata grows to GS_USERDATA_SIZE.
+// Checks every muscle's and contact sphere's parameters. Call before mj_makeData. Returns 0, or
+// -1 with the reason (naming the actuator or geom) in err.
+int gs_physics_prepare(mjModel* m, char* err, int errsz);
+
+// Install the callbacks (process-global). Call once, before threads start. Idempotent.
+void gs_physics_install(void);
+
+// Tendon tension (N, >= 0 when pulling) of gaitsim muscle actuator i at the current state:
+// rigid tendon from activation and actuator length/velocity; elastic tendon Fmax * userdata[i].
+// out (may be NULL) receives fibre length, velocity, pennation and force components; for elastic
+// tendons the fibre velocity is the one that satisfies the Hill equilibrium (forward model).
+// Needs actuator_length/velocity (mj_fwdPosition, mj_fwdVelocity).
+double gs_physics_muscle_tension(const mjModel* m, const mjData* d, int i, gsMuscleOut* out);
+
+// Normalised tendon-force rate dfT/dt (1/s) of every elastic-tendon muscle at the current state,
+// from the Hill equilibrium (forward model), into fT_dot (nu; 0 for other actuators). Needs
+// mj_fwdPosition and mj_fwdVelocity. Returns the number of muscles whose equilibrium was clamped.
+int gs_physics_tendon_force_rates(const mjModel* m, const mjData* d, mjtNum* fT_dot);
+
+// One forward-simulation step with the fibre states integrated too: mj_step1, tendon-force rates
+// at the step's start state, mj_step2 (MuJoCo integrates q, qdot, act), then semi-implicit Euler
+// on d->userdata with the same timestep. fT_dot is scratch (nu). Returns 0, or -1 when a state
+// became non-finite.
+int gs_physics_step(const mjModel* m, mjData* d, mjtNum* fT_dot);
+
+// Hunt-Crossley forces of every contact sphere added to d->qfrc_passive (the mjcb_passive body;
+// exposed for tests). Needs positions and velocities (mj_fwdPosition, mj_fwdVelocity's comVel).
+void gs_physics_contact_passive(const mjModel* m, mjData* d);
+
+// Ground reaction of one foot (side 'r' or 'l') from its contact spheres at the current state:
+// force, centre of pressure and free moment (gs_contact_foot_grf; COP defined above fn_min N).
+void gs_physics_foot_grf(const mjModel* m, const mjData* d, int side, double fn_min,
+                         gsFootGrf* grf);
+
+#endif  // GAITSIM_CALLBACKS_GS_PHYSICS_H_

@@ -23,5 +23,5 @@ cmake --build build-asan -j"$jobs"
 
 echo "== fuzz targets (clang, libFuzzer, bounded time)"
 CC=clang cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=Debug -DGAITSIM_FUZZ=ON >/dev/null
-cmake --build build-fuzz -j"$jobs"
+cmake --build build-fuzz -j"$jobs" --target fuzz_storage
 (cd build-fuzz && ctest --output-on-failure -L fuzz)

@@ -1,0 +1,106 @@
+// go_ipopt.h: solve a collocation NLP (go_collocation.h) with Ipopt 3.11.9 through its C interface.
+//
+// Fixed settings (overridable by options): limited-memory Hessian (eval_h exists and returns
+// FALSE), MUMPS, no banner (sb yes), print_level 0, no ./ipopt.opt (option_file_name ""), no
+// Ipopt scaling (nlp_scaling_method none: the engine scales, go_collocation.h). OpenBLAS is set to
+// one thread. One progress line per iteration goes to opts.progress.
+//
+// Best iterate: the C interface's intermediate callback does not expose x. Ipopt evaluates the
+// constraint Jacobian only at iterates (never at line-search trial points), and always at the
+// current iterate before that iterate's intermediate callback (it needs J for the dual
+// infeasibility). So the engine copies x at every eval_jac_g and, at the callback, scores that
+// point with the g and f cached from eval_g/eval_f when they were evaluated at the same x (else it
+// evaluates them once more). Score: smaller max scaled constraint violation wins, except that
+// among points with violation <= best_viol_tol the smaller objective wins; non-finite values never
+// win. The final point Ipopt returns is scored as well. Limits: in the restoration phase the
+// iterates are those of the restoration problem (their x part is scored, which is fine); a point
+// whose Jacobian evaluation failed is never scored.
+#ifndef GAITSIM_OPTIM_GO_IPOPT_H_
+#define GAITSIM_OPTIM_GO_IPOPT_H_
+
+#include <stdio.h>
+
+#include "optim/go_collocation.h"
+
+#define GO_IPOPT_MAX_OPTIONS 64
+
+typedef struct {
+  char key[64];    // Ipopt option name
+  char val[192];   // its value as text (type chosen by go_ipopt_solve)
+} go_ipopt_kv;
+
+typedef struct {
+  int max_iter;           // iteration limit; < 0: Ipopt default (3000)
+  double max_wall_s;      // wall-clock limit (s); <= 0: none
+  double tol;             // Ipopt tol; <= 0: Ipopt default (1e-8)
+  double best_viol_tol;   // violations at or below count as feasible for the best iterate
+  FILE* progress;         // one line per iteration; NULL: silent
+  int handle_sigint;      // 1: Ctrl-C stops the solve cleanly (handler restored afterwards)
+  int n_kv;               // extra Ipopt options, applied after all of the above, in order
+  go_ipopt_kv kv[GO_IPOPT_MAX_OPTIONS];
+} go_ipopt_opts;
+
+typedef enum {
+  GO_SOLVE_SUCCESS = 0,        // optimal to tol
+  GO_SOLVE_ACCEPTABLE,         // optimal to the acceptable tolerances
+  GO_SOLVE_FEASIBLE,           // feasible point found (square problems)
+  GO_SOLVE_MAX_ITER,           // iteration limit
+  GO_SOLVE_MAX_WALL_TIME,      // our wall-clock limit
+  GO_SOLVE_MAX_CPU_TIME,       // Ipopt's max_cpu_time
+  GO_SOLVE_INTERRUPTED,        // SIGINT or go_ipopt_request_stop()
+  GO_SOLVE_INFEASIBLE,         // locally infeasible
+  GO_SOLVE_SMALL_STEP,         // search direction too small
+  GO_SOLVE_DIVERGING,          // iterates diverging
+  GO_SOLVE_RESTORATION_FAILED, // restoration phase failed
+  GO_SOLVE_STEP_ERROR,         // error in step computation
+  GO_SOLVE_EVAL_ERROR,         // invalid number in a function or derivative
+  GO_SOLVE_BAD_PROBLEM,        // not enough degrees of freedom or invalid problem definition
+  GO_SOLVE_BAD_OPTION,         // invalid option
+  GO_SOLVE_INTERNAL_ERROR,     // exceptions, memory, internal errors, user stop of unknown cause
+} go_solve_status;
+
+typedef struct {
+  go_solve_status status;   // mapped from Ipopt's ApplicationReturnStatus
+  int ipopt_status;         // the ApplicationReturnStatus itself
+  int iterations;           // iterations done
+  double wall_s;            // wall-clock time of the solve (s)
+  double cpu_s;             // process CPU time of the solve, all threads (s)
+  double objective;         // physical objective J at the returned point
+  double max_viol;          // max scaled constraint violation at the returned point
+  int best_iter;            // iteration of the best iterate (-1: none scored)
+  double best_objective;    // physical objective at the best iterate
+  double best_viol;         // max scaled constraint violation at the best iterate
+} go_solve_result;
+
+// optional multipliers in the solver's scaling: in (when warm != 0) and out (when non-NULL)
+typedef struct {
+  double* g;     // constraint multipliers (m)
+  double* z_l;   // lower bound multipliers (n)
+  double* z_u;   // upper bound multipliers (n)
+  int warm;      // 1: start from these (sets warm_start_init_point yes)
+} go_ipopt_mult;
+
+// defaults: max_iter -1, no wall limit, tol default, best_viol_tol 1e-6, progress NULL,
+// handle_sigint 0, no extra options
+void go_ipopt_opts_default(go_ipopt_opts* opts);
+
+// add one option "key=value" (command line --ipopt key=value) or key, value; 0 or -1 and err
+int go_ipopt_opts_add(go_ipopt_opts* opts, const char* key_eq_value, char* err, int errsz);
+int go_ipopt_opts_set(go_ipopt_opts* opts, const char* key, const char* value, char* err, int errsz);
+
+// add the options of a file: "key value" per line, '#' starts a comment; 0 or -1 and err
+int go_ipopt_opts_read_file(go_ipopt_opts* opts, const char* path, char* err, int errsz);
+
+// Solve. z (n, physical): in the initial guess, out the point Ipopt returns. z_best (n, physical,
+// may be NULL): the best iterate (see above). mult may be NULL. Returns 0 when Ipopt ran (the
+// outcome is res->status, whatever it is), -1 with err when the solve could not start.
+int go_ipopt_solve(go_nlp* nlp, const go_ipopt_opts* opts, double* z, double* z_best,
+                   go_ipopt_mult* mult, go_solve_result* res, char* err, int errsz);
+
+// human-readable status
+const char* go_solve_status_str(go_solve_status status);
+
+// ask a running solve to stop at its next iteration (async-signal-safe)
+void go_ipopt_request_stop(void);
+
+#endif  // GAITSIM_OPTIM_GO_IPOPT_H_

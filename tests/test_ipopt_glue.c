@@ -1,0 +1,224 @@
+// test_ipopt_glue.c: the Ipopt glue's stopping rules, best iterate, option handling, and that a
+// ./ipopt.opt in the working directory is ignored. Problem: the minimum-effort double integrator
+// (x'' = u, x: 0 -> 1 at rest, T = 1, N = 21).
+#define _POSIX_C_SOURCE 200809L
+#include <math.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "optim/go_collocation.h"
+#include "optim/go_ipopt.h"
+#include "tests/gs_test.h"
+
+enum { N = 21, NZ = 5 };
+
+static int raise_after = -1;  // path calls before raising SIGINT (-1: never)
+
+static int path(void* ctx, int k, const double* z, double* g) {
+  if (raise_after >= 0 && raise_after-- == 0) raise(SIGINT);
+  g[0] = z[2] - z[1];
+  g[1] = z[3] - z[4];
+  return 0;
+}
+static int integrand(void* ctx, int k, const double* z, double* L) {
+  *L = z[4] * z[4];
+  return 0;
+}
+static const int pcol[6] = {0, 0, 1, 2, 3, 4};
+static const int prow[4] = {0, 0, 1, 1};
+static const int ivars[1] = {4};
+
+static go_nlp* make(void) {
+  static go_bound_override ov[4] = {
+      {0, 0, 0.0, 0.0}, {0, 1, 0.0, 0.0}, {-1, 0, 1.0, 1.0}, {-1, 1, 0.0, 0.0}};
+  go_problem p;
+  memset(&p, 0, sizeof(p));
+  p.dims = (go_dims){N, 2, 1, 2, 0, 0};
+  p.T = 1.0;
+  p.overrides = ov;
+  p.n_overrides = 4;
+  p.path = path;
+  p.path_col_ptr = pcol;
+  p.path_row_idx = prow;
+  p.integrand = integrand;
+  p.integrand_vars = ivars;
+  p.n_integrand_vars = 1;
+  p.nthreads = 1;
+  go_nlp* nlp = NULL;
+  char err[256];
+  if (go_nlp_create(&nlp, &p, err, sizeof(err))) fprintf(stderr, "create: %s\n", err);
+  return nlp;
+}
+
+static void guess(double* z) {
+  for (int k = 0; k < N; k++) {
+    double t = (double)k / (N - 1), g[NZ] = {t * t, 0.3, 0.3, 0.0, 0.5};
+    memcpy(z + k * NZ, g, sizeof(g));
+  }
+}
+
+// max violation of the scaled constraints at physical z
+static double violation(go_nlp* nlp, const double* z) {
+  double zs[N * NZ], g[(N - 1) * 2 + N * 2];
+  go_nlp_scale_z(nlp, z, zs);
+  if (go_nlp_eval_g(nlp, zs, g)) return INFINITY;
+  return go_nlp_violation(nlp, g);
+}
+
+// solve with stdout captured; returns bytes written to stdout
+static long solve(go_nlp* nlp, go_ipopt_opts* o, double* z, double* zb, go_ipopt_mult* mu,
+                  go_solve_result* r, int* rc, char* err) {
+  char path_[] = "/tmp/gs_test_ipopt_XXXXXX";
+  int fd = mkstemp(path_);
+  fflush(stdout);
+  int saved = dup(1);
+  dup2(fd, 1);
+  *rc = go_ipopt_solve(nlp, o, z, zb, mu, r, err, 256);
+  fflush(stdout);
+  dup2(saved, 1);
+  close(saved);
+  long bytes = (long)lseek(fd, 0, SEEK_END);
+  close(fd);
+  unlink(path_);
+  return bytes;
+}
+
+static void on_sig(int s) { (void)s; }
+
+int main(void) {
+  go_nlp* nlp = make();
+  EXPECT_TRUE(nlp != NULL);
+  if (!nlp) return GS_TEST_RESULT();
+  double z[N * NZ], zb[N * NZ];
+  char err[256];
+  go_solve_result r;
+  int rc;
+  go_ipopt_opts o;
+
+  // iteration limit: right status, and a best iterate that is what it claims
+  go_ipopt_opts_default(&o);
+  o.max_iter = 2;
+  guess(z);
+  double v0 = violation(nlp, z);
+  EXPECT_EQ_INT(0, solve(nlp, &o, z, zb, NULL, &r, &rc, err));
+  EXPECT_EQ_INT(0, rc);
+  EXPECT_EQ_INT(GO_SOLVE_MAX_ITER, r.status);
+  EXPECT_EQ_INT(2, r.iterations);
+  EXPECT_TRUE(r.best_iter >= 0 && r.best_iter <= 2);
+  EXPECT_TRUE(isfinite(r.best_objective));
+  EXPECT_TRUE(r.best_viol <= r.max_viol);
+  EXPECT_TRUE(r.best_viol < v0);
+  EXPECT_NEAR(r.best_viol, violation(nlp, zb), 1e-12);
+  printf("iteration limit: %s after %d, best iterate %d (viol %.2e, J %.4f), start viol %.2e\n",
+         go_solve_status_str(r.status), r.iterations, r.best_iter, r.best_viol, r.best_objective, v0);
+
+  // ./ipopt.opt in the working directory is not read (it would stop after 1 iteration and print)
+  char cwd[4096], dir[] = "/tmp/gs_test_ipoptopt_XXXXXX";
+  EXPECT_TRUE(getcwd(cwd, sizeof(cwd)) != NULL);
+  EXPECT_TRUE(mkdtemp(dir) != NULL);
+  EXPECT_EQ_INT(0, chdir(dir));
+  FILE* f = fopen("ipopt.opt", "w");
+  fprintf(f, "max_iter 1\nprint_level 5\n");
+  fclose(f);
+  go_ipopt_opts_default(&o);
+  guess(z);
+  long out = solve(nlp, &o, z, zb, NULL, &r, &rc, err);
+  unlink("ipopt.opt");
+  EXPECT_EQ_INT(0, chdir(cwd));
+  rmdir(dir);
+  EXPECT_EQ_INT(0, rc);
+  EXPECT_EQ_INT(0, out);
+  EXPECT_EQ_INT(GO_SOLVE_SUCCESS, r.status);
+  EXPECT_TRUE(r.iterations > 1);
+  EXPECT_EQ_INT(r.iterations, r.best_iter);
+  printf("./ipopt.opt ignored: %s in %d iterations, %ld bytes on stdout\n",
+         go_solve_status_str(r.status), r.iterations, out);
+
+  // warm start from the solution and its multipliers: converges at once
+  {
+    double mg[(N - 1) * 2 + N * 2], ml[N * NZ], mu[N * NZ];
+    go_ipopt_mult m = {mg, ml, mu, 0};
+    go_ipopt_opts_default(&o);
+    guess(z);
+    solve(nlp, &o, z, NULL, &m, &r, &rc, err);
+    int cold = r.iterations;
+    m.warm = 1;
+    EXPECT_EQ_INT(0, go_ipopt_opts_add(&o, "warm_start_bound_push=1e-9", err, sizeof(err)));
+    EXPECT_EQ_INT(0, go_ipopt_opts_add(&o, "mu_init=1e-9", err, sizeof(err)));
+    solve(nlp, &o, z, NULL, &m, &r, &rc, err);
+    EXPECT_EQ_INT(GO_SOLVE_SUCCESS, r.status);
+    EXPECT_TRUE(r.iterations < cold);
+    printf("warm start: %d iterations (cold %d)\n", r.iterations, cold);
+  }
+
+  // wall-time limit
+  go_ipopt_opts_default(&o);
+  o.max_wall_s = 1e-9;
+  guess(z);
+  solve(nlp, &o, z, zb, NULL, &r, &rc, err);
+  EXPECT_EQ_INT(0, rc);
+  EXPECT_EQ_INT(GO_SOLVE_MAX_WALL_TIME, r.status);
+  EXPECT_EQ_INT(0, r.iterations);
+  EXPECT_TRUE(r.best_iter == 0);
+
+  // Ctrl-C: stops cleanly at the next iteration; the caller's handler is restored
+  struct sigaction mine, now;
+  memset(&mine, 0, sizeof(mine));
+  mine.sa_handler = on_sig;
+  sigemptyset(&mine.sa_mask);
+  sigaction(SIGINT, &mine, NULL);
+  go_ipopt_opts_default(&o);
+  o.handle_sigint = 1;
+  guess(z);
+  raise_after = 3 * N;
+  solve(nlp, &o, z, zb, NULL, &r, &rc, err);
+  raise_after = -1;
+  EXPECT_EQ_INT(0, rc);
+  EXPECT_EQ_INT(GO_SOLVE_INTERRUPTED, r.status);
+  EXPECT_TRUE(r.best_iter >= 0);
+  sigaction(SIGINT, NULL, &now);
+  EXPECT_TRUE(now.sa_handler == on_sig);
+  printf("interrupted: %s at iteration %d\n", go_solve_status_str(r.status), r.iterations);
+
+  // options: file with comments, key=value, errors
+  char opt_path[] = "/tmp/gs_test_opts_XXXXXX";
+  int fd = mkstemp(opt_path);
+  f = fdopen(fd, "w");
+  fprintf(f, "# a comment\n\nmax_iter 7   # trailing comment\nmu_strategy adaptive\ntol 1e-7\n");
+  fclose(f);
+  go_ipopt_opts_default(&o);
+  EXPECT_EQ_INT(0, go_ipopt_opts_read_file(&o, opt_path, err, sizeof(err)));
+  EXPECT_EQ_INT(3, o.n_kv);
+  EXPECT_TRUE(!strcmp(o.kv[0].key, "max_iter") && !strcmp(o.kv[0].val, "7"));
+  EXPECT_TRUE(!strcmp(o.kv[1].val, "adaptive"));
+  guess(z);
+  out = solve(nlp, &o, z, zb, NULL, &r, &rc, err);
+  EXPECT_EQ_INT(0, rc);
+  EXPECT_EQ_INT(0, out);
+  EXPECT_TRUE(r.iterations <= 7);
+  f = fopen(opt_path, "w");
+  fprintf(f, "max_iter\n");
+  fclose(f);
+  EXPECT_EQ_INT(-1, go_ipopt_opts_read_file(&o, opt_path, err, sizeof(err)));
+  EXPECT_TRUE(strstr(err, ":1:") != NULL);
+  unlink(opt_path);
+  EXPECT_EQ_INT(-1, go_ipopt_opts_read_file(&o, "/nonexistent/opts", err, sizeof(err)));
+  EXPECT_EQ_INT(-1, go_ipopt_opts_add(&o, "max_iter", err, sizeof(err)));
+  go_ipopt_opts_default(&o);
+  EXPECT_EQ_INT(0, go_ipopt_opts_add(&o, "linear_solver=ma97", err, sizeof(err)));
+  EXPECT_EQ_INT(-1, go_ipopt_solve(nlp, &o, z, NULL, NULL, &r, err, sizeof(err)));
+  EXPECT_TRUE(strstr(err, "ma97") != NULL);
+  go_ipopt_opts_default(&o);
+  EXPECT_EQ_INT(0, go_ipopt_opts_add(&o, "max_iter=abc", err, sizeof(err)));
+  EXPECT_EQ_INT(-1, go_ipopt_solve(nlp, &o, z, NULL, NULL, &r, err, sizeof(err)));
+  EXPECT_TRUE(strstr(err, "integer") != NULL);
+
+  // every status has a text
+  for (int s = GO_SOLVE_SUCCESS; s <= GO_SOLVE_INTERNAL_ERROR; s++)
+    EXPECT_TRUE(strcmp(go_solve_status_str((go_solve_status)s), "unknown status") != 0);
+
+  go_nlp_free(nlp);
+  return GS_TEST_RESULT();
+}

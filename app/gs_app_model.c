@@ -1,0 +1,47 @@
+// gs_app_model.c: model preparation and table I/O shared by the subcommands.
+#include "app/gs_app_model.h"
+
+#include <stdio.h>
+
+#include "callbacks/gs_mujoco.h"
+#include "callbacks/gs_physics.h"
+#include "callbacks/gs_state.h"
+#include "io/gs_storage.h"
+
+mjModel* gs_app_load_model(const char* path) {
+  char err[1024];
+  mjModel* m = gs_model_load(path, err, sizeof(err));
+  if (!m) {
+    fprintf(stderr, "gaitsim: %s: %s\n", path, err);
+    return NULL;
+  }
+  if (gs_physics_prepare(m, err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s: %s\n", path, err);
+    mj_deleteModel(m);
+    return NULL;
+  }
+  gs_physics_install();
+  return m;
+}
+
+int gs_app_read_table(const mjModel* m, const char* path, gsTable* t) {
+  char err[1024];
+  gs_table_init(t);
+  if (gs_storage_read(path, t, err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s\n", err);
+    return -1;
+  }
+  gs_table_to_radians(t, gs_state_is_angle, (void*)m);
+  return 0;
+}
+
+int gs_app_write_table(const char* dir, const char* name, const gsTable* t) {
+  char path[4096], err[1024];
+  snprintf(path, sizeof(path), "%s/%s", dir, name);
+  const char* header[] = {"gaitsim_version=" GAITSIM_VERSION};
+  if (gs_storage_write(path, t, header, 1, err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s\n", err);
+    return -1;
+  }
+  return 0;
+}

@@ -1,0 +1,25 @@
+// gs_app_model.h: what every subcommand does to get a model ready: load, switch to gaitsim's
+// physics, install the callbacks; and small helpers shared by the subcommands.
+#ifndef GAITSIM_APP_GS_APP_MODEL_H_
+#define GAITSIM_APP_GS_APP_MODEL_H_
+
+#include <mujoco/mujoco.h>
+
+#include "io/gs_table.h"
+
+// Load MODEL and prepare it for gaitsim's physics (gs_physics_prepare, gs_physics_install).
+// Prints "gaitsim: MODEL: reason" and returns NULL on failure.
+mjModel* gs_app_load_model(const char* path);
+
+// Read a storage file (.sto/.mot/.csv) for model m, angles converted to radians. Prints
+// "gaitsim: FILE: reason" and returns -1 on failure.
+int gs_app_read_table(const mjModel* m, const char* path, gsTable* t);
+
+// Write table t to DIR/NAME atomically with gaitsim's header lines. Prints the reason and
+// returns -1 on failure.
+int gs_app_write_table(const char* dir, const char* name, const gsTable* t);
+
+// Default bundled model: GAITSIM_SOURCE_DIR/mjmodels/jw_fullbody.xml.
+#define GS_DEFAULT_MODEL GAITSIM_SOURCE_DIR "/mjmodels/jw_fullbody.xml"
+
+#endif  // GAITSIM_APP_GS_APP_MODEL_H_

@@ -7,5 +7,6 @@ const gsCommand gs_commands[] = {
     {"run", gs_cmd_run, "run the default pipeline on the bundled trial"},
     {"info", gs_cmd_info, "summarise a model: degrees of freedom, muscles, contacts, mass"},
     {"simulate", gs_cmd_simulate, "forward simulation with gaitsim's muscles and foot contact"},
+    {"inspect", gs_cmd_inspect, "one row per muscle at one instant: lengths, force, metabolics, moment arms"},
     {NULL, NULL, NULL},
 };

@@ -41,6 +41,19 @@ double gs_physics_muscle_tension(const mjModel* m, const mjData* d, int i, gsMus
   return gs_muscle_rigid_force(&prm, a, d->actuator_length[i], d->actuator_velocity[i], NULL, out);
 }
 
+double gs_physics_muscle_metabolics(const mjModel* m, const mjData* d, int i,
+                                    gsUmbergerTerms* terms) {
+  gsUmbergerMuscle mus;
+  if (gs_umberger_muscle_from_user(actuator_user(m, i), &mus, NULL, 0) != 0) {
+    return 0;
+  }
+  gsMuscleOut out;
+  gs_physics_muscle_tension(m, d, i, &out);
+  gsUmbergerInput in = {d->ctrl[i], actuator_activation(m, d, i), out.lM_norm, out.vM,
+                        out.f_active, out.fL};
+  return gs_umberger2010(&mus, &in, terms);
+}
+
 // mjcb_act_dyn: da/dt from excitation ctrl[i] and activation (De Groote 2016, gs_activation.h)
 static mjtNum gs_act_dyn_callback(const mjModel* m, const mjData* d, int i) {
   gsActivationParams prm;
@@ -79,9 +92,14 @@ int gs_physics_tendon_force_rates(const mjModel* m, const mjData* d, mjtNum* fT_
 }
 
 int gs_physics_step(const mjModel* m, mjData* d, mjtNum* fT_dot) {
+  // MuJoCo resets the state (time included) when it finds a bad acceleration: count those
+  int bad_before = d->warning[mjWARN_BADQACC].number;
   mj_step1(m, d);
   gs_physics_tendon_force_rates(m, d, fT_dot);
   mj_step2(m, d);
+  if (d->warning[mjWARN_BADQACC].number != bad_before) {
+    return -1;
+  }
   int finite = 1;
   for (int i = 0; i < m->nu; i++) {
     d->userdata[i] += m->opt.timestep * fT_dot[i];

@@ -20,6 +20,7 @@
 #include <mujoco/mujoco.h>
 
 #include "callbacks/gs_contact.h"
+#include "callbacks/gs_metabolics.h"
 #include "callbacks/gs_muscle.h"
 
 // doubles of d->userdata the physics uses
@@ -40,6 +41,12 @@ void gs_physics_install(void);
 // tendons the fibre velocity is the one that satisfies the Hill equilibrium (forward model).
 // Needs actuator_length/velocity (mj_fwdPosition, mj_fwdVelocity).
 double gs_physics_muscle_tension(const mjModel* m, const mjData* d, int i, gsMuscleOut* out);
+
+// Metabolic power (W) of gaitsim muscle actuator i at the current state (Umberger 2010, exact
+// model, gs_metabolics.h): excitation ctrl[i], activation, fibre length and velocity from the
+// muscle state (gs_physics_muscle_tension). terms (may be NULL) receives every term.
+double gs_physics_muscle_metabolics(const mjModel* m, const mjData* d, int i,
+                                    gsUmbergerTerms* terms);
 
 // Normalised tendon-force rate dfT/dt (1/s) of every elastic-tendon muscle at the current state,
 // from the Hill equilibrium (forward model), into fT_dot (nu; 0 for other actuators). Needs

@@ -1,0 +1,125 @@
+// cmd_inspect.c: `gaitsim inspect MODEL --pose FILE --time t`: one row per muscle at one
+// instant: muscle-tendon length, fibre length, tendon tension, metabolic rate and moment arms.
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+
+#include <mujoco/mujoco.h>
+
+#include "app/gs_app_model.h"
+#include "app/gs_commands.h"
+#include "callbacks/gs_model_info.h"
+#include "callbacks/gs_muscle.h"
+#include "callbacks/gs_physics.h"
+#include "callbacks/gs_state.h"
+
+static const char* kInspectUsage =
+    "usage: gaitsim inspect MODEL --pose FILE [--time T] [--activation A]\n\n"
+    "One row per muscle at time T (s, default the file's first row) of FILE (a states.sto,\n"
+    "or coordinates .mot; missing speeds are 0, missing activations A (default 0.05), missing\n"
+    "excitations equal the activation, missing tendon forces in static equilibrium):\n"
+    "muscle-tendon length lMT (m), fibre length lM (m) and lM/lopt, tendon tension F (N),\n"
+    "metabolic rate (W, Umberger 2010) and the moment arms (m or m/m) above 0.1 mm.\n";
+
+int gs_cmd_inspect(int argc, char** argv) {
+  static const struct option options[] = {{"pose", required_argument, NULL, 'p'},
+                                          {"time", required_argument, NULL, 't'},
+                                          {"activation", required_argument, NULL, 'a'},
+                                          {"help", no_argument, NULL, 'h'},
+                                          {NULL, 0, NULL, 0}};
+  const char* pose = NULL;
+  double time = NAN, activation = 0.05;
+  optind = 1;
+  int c;
+  char* end;
+  while ((c = getopt_long(argc, argv, "p:t:a:h", options, NULL)) != -1) {
+    switch (c) {
+      case 'p': pose = optarg; break;
+      case 't': time = strtod(optarg, &end); if (*end || end == optarg) c = '?'; break;
+      case 'a': activation = strtod(optarg, &end); if (*end || end == optarg) c = '?'; break;
+      case 'h': fputs(kInspectUsage, stdout); return GS_EXIT_OK;
+      default: break;
+    }
+    if (c == '?') {
+      fputs(kInspectUsage, stderr);
+      return GS_EXIT_USAGE;
+    }
+  }
+  if (optind != argc - 1 || !pose || activation < 0 || activation > 1) {
+    fputs(kInspectUsage, stderr);
+    return GS_EXIT_USAGE;
+  }
+  const char* path = argv[optind];
+  mjModel* m = gs_app_load_model(path);
+  if (!m) {
+    return GS_EXIT_FAILURE;
+  }
+  int status = GS_EXIT_FAILURE;
+  mjData* d = mj_makeData(m);
+  gsTable t;
+  gsStateMap map = {0};
+  char err[512];
+  if (gs_app_read_table(m, pose, &t) != 0) {
+    goto done;
+  }
+  if (gs_state_map(m, &t, &map, err, sizeof(err)) != 0 || map.nq_found == 0) {
+    fprintf(stderr, "gaitsim: %s: %s\n", pose,
+            map.qpos_col ? "no column names a coordinate of the model" : err);
+    goto done;
+  }
+  if (isnan(time)) {
+    time = t.time[0];
+  }
+  if (time < t.time[0] || time > t.time[t.nrow - 1]) {
+    fprintf(stderr, "gaitsim: %s: time %g s outside the file's %g..%g s\n", pose, time,
+            t.time[0], t.time[t.nrow - 1]);
+    goto done;
+  }
+  for (int i = 0; i < m->na; i++) d->act[i] = activation;
+  for (int i = 0; i < m->nu; i++) d->ctrl[i] = activation;
+  gs_state_apply(m, &t, &map, time, d);
+  if (map.nctrl_found == 0) {  // excitations default to the activation
+    for (int i = m->nu - m->na; i < m->nu; i++) d->ctrl[i] = d->act[i - (m->nu - m->na)];
+  }
+  mj_forward(m, d);
+  for (int i = 0; i < m->nu; i++) {  // tendon forces not given: static equilibrium
+    gsMuscleParams prm;
+    if (map.fT_col[i] >= 0 || !gs_actuator_has_elastic_tendon(m, i) ||
+        gs_muscle_params_from_user(m->actuator_user + i * m->nuser_actuator, &prm, NULL, 0) != 0) {
+      continue;
+    }
+    gs_muscle_equilibrium_fT(&prm, d->act[i - (m->nu - m->na)], d->actuator_length[i],
+                             &d->userdata[i], NULL);
+  }
+  mj_forward(m, d);
+  printf("%s at t = %.4f s of %s\n", path, time, pose);
+  printf("%-16s %-7s %8s %8s %7s %9s %9s  %s\n", "muscle", "tendon", "lMT (m)", "lM (m)",
+         "lM/lopt", "F (N)", "Edot (W)", "moment arms (m)");
+  for (int i = 0; i < m->nu; i++) {
+    if (!gs_actuator_is_gaitsim_muscle(m, i)) {
+      continue;
+    }
+    gsMuscleOut out;
+    double force = gs_physics_muscle_tension(m, d, i, &out);
+    double power = gs_physics_muscle_metabolics(m, d, i, NULL);
+    printf("%-16s %-7s %8.4f %8.4f %7.3f %9.1f %9.2f ", mj_id2name(m, mjOBJ_ACTUATOR, i),
+           gs_actuator_has_elastic_tendon(m, i) ? "elastic" : "rigid", d->actuator_length[i],
+           out.lM, out.lM_norm, force, power);
+    for (int j = 0; j < m->njnt; j++) {
+      // MuJoCo's actuator_moment is dL/dq; the moment arm is -dL/dq (OpenSim's convention)
+      double r = -d->actuator_moment[i * m->nv + m->jnt_dofadr[j]];
+      if (fabs(r) > 1e-4) {
+        printf(" %s=%.4f", mj_id2name(m, mjOBJ_JOINT, j), r);
+      }
+    }
+    printf("\n");
+  }
+  status = GS_EXIT_OK;
+done:
+  gs_state_map_free(&map);
+  gs_table_free(&t);
+  mj_deleteData(d);
+  mj_deleteModel(m);
+  return status;
+}

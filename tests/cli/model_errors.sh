@@ -28,13 +28,16 @@ out=$("$gaitsim" info ok.xml --json)
 check "json dof" grep -q '"dof":[[:space:]]*1' <<<"$out"
 check "json mass" grep -q '"mass_kg":[[:space:]]*2' <<<"$out"
 
-# broken models: each exits 1 with one line naming the file; stdin held open must not block
+# broken models: each exits 1 with one line naming the file, without waiting on stdin
 printf '<mujoco><worldbody><geom type="sphere"/></worldbody></mujoco>' > zero_size.xml
 printf '<mujoco><worldbody' > truncated.xml
 printf '<mujoco><worldbody><body><joint axis="0 0 0"/><geom size=".1"/></body></worldbody></mujoco>' > zero_axis.xml
 printf 'not xml at all' > garbage.xml
+# stdin: a FIFO held open for reading and writing, so a prompt would block until timeout
+mkfifo stdin.fifo
+exec 3<>stdin.fifo
 for model in zero_size.xml truncated.xml zero_axis.xml garbage.xml missing.xml; do
-  err=$(timeout 10 "$gaitsim" info "$model" 2>&1 >/dev/null < <(sleep 15))
+  err=$(timeout 10 "$gaitsim" info "$model" 2>&1 >/dev/null <&3)
   status=$?
   check "$model exits 1 (got $status)" test "$status" -eq 1
   check "$model one line" test "$(printf '%s\n' "$err" | wc -l)" -eq 1

@@ -86,17 +86,25 @@ TENDON_KT = 35.0          # De Groote et al. 2016 tendon shape factor (-)
 
 # Hunt-Crossley sphere parameters (geom user row, gs_model_layout.h order)
 CONTACT_USER = [1.0e6, 2.0, 0.8, 0.8, 0.5, 0.2]
-# contact spheres in the calcaneus frame (m), right foot; z is mirrored for the left foot.
-# Adapted from antoinefalisse/3dpredictsim (Falisse et al. 2019) to JW's foot; 5-6 go on the toes.
+# Contact spheres in the FOOT FRAME F of each foot (mjmodels/README.md, "Contact spheres"):
+# origin at the calcaneus origin, y up (normal of the sole) and x forward along the horizontal
+# projection of the calcaneus-origin -> mtp-joint-centre line, both in the standing pose
+# (ankle_angle = subtalar_angle = 0), z = x cross y (to the right). Values are for the right
+# foot with z lateral; the left foot mirrors z. Every sphere's bottom lies on the sole plane,
+# SOLE_DEPTH below the lower of the two calcaneus origins at the standing pose, so the centre
+# height is the radius. Spheres 1-4 go on the calcaneus, 5-6 on the toes (gs_model_layout.h).
 CONTACT_SPHERES = [
-    # (index, x, y, z, radius)
-    (1, 0.0019, -0.0100, -0.0038, 0.032),
-    (2, 0.1484, -0.0100, -0.0287, 0.032),
-    (3, 0.1330, -0.0100, 0.0516, 0.032),
-    (4, 0.0662, -0.0100, 0.0265, 0.032),
-    (5, 0.2366, -0.0120, -0.0188, 0.020),
-    (6, 0.2216, -0.0120, 0.0602, 0.020),
+    # (index, x forward, z lateral, radius, on toes)
+    (1, 0.015, -0.016, 0.032, False),   # heel, medial (under the calcaneal tuberosity)
+    (2, 0.165, -0.030, 0.032, False),   # first metatarsal head (medial forefoot)
+    (3, 0.140, 0.035, 0.032, False),    # fifth metatarsal head (lateral forefoot)
+    (4, 0.015, 0.016, 0.032, False),    # heel, lateral
+    (5, 0.215, -0.028, 0.020, True),    # hallux
+    (6, 0.195, 0.020, 0.020, True),     # lateral toes
 ]
+# sole plane below the calcaneus origin (m): 3dpredictsim's heel sphere, centre 0.010 below the
+# calcaneus origin with radius 0.032
+SOLE_DEPTH = 0.042
 
 EPS_ZERO = 1e-8           # |default value| below which a coordinate default counts as 0
 FD_STEP = 1e-5            # central-difference step for moment arms (rad or m)
@@ -938,6 +946,113 @@ def metabolic_key(name):
     return GAIT2392_NAME[name] + "_r"
 
 
+def whole_body_com(model, x):
+    """Whole-body centre of mass (OpenSim ground frame) from body transforms x."""
+    total, acc = 0.0, [0.0, 0.0, 0.0]
+    for name, b in model.bodies.items():
+        if b["mass"] > 0.0:
+            total += b["mass"]
+            acc = vec_add(acc, vec_scale(tf_point(x[name], b["com"]), b["mass"]))
+    return vec_scale(acc, 1.0 / total)
+
+
+def bisect(f, lo, hi, iterations=60):
+    """Root of f on [lo, hi] (f(lo), f(hi) of opposite sign), fixed iteration count."""
+    flo = f(lo)
+    for _ in range(iterations):
+        mid = 0.5 * (lo + hi)
+        fm = f(mid)
+        if (fm < 0.0) == (flo < 0.0):
+            lo, flo = mid, fm
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
+def contact_spheres(model, x):
+    """Contact spheres for body transforms x (the standing pose): CONTACT_SPHERES placed in each
+    foot frame F, every bottom on the horizontal sole plane SOLE_DEPTH below the lower calcaneus
+    origin. Returns ({body: [(geom name, local position, radius)]}, contact points (ground
+    frame, on the sole), sole height)."""
+    sole = min(x["calcaneus"][1][1], x["calcaneus_l"][1][1]) - SOLE_DEPTH
+    contacts, points = {}, []
+    for side, calc, toes, zsign in (("r", "calcaneus", "toes", 1.0),
+                                    ("l", "calcaneus_l", "toes_l", -1.0)):
+        org = x[calc][1]
+        fwd = vec_sub(x[toes][1], org)
+        ex = unit([fwd[0], 0.0, fwd[2]])
+        ey = [0.0, 1.0, 0.0]
+        ez = [ex[1] * ey[2] - ex[2] * ey[1], ex[2] * ey[0] - ex[0] * ey[2],
+              ex[0] * ey[1] - ex[1] * ey[0]]
+        for k, fx, fz, r, on_toes in CONTACT_SPHERES:
+            height = sole + r - org[1]
+            world = vec_add(org, vec_add(vec_add(vec_scale(ex, fx), vec_scale(ey, height)),
+                                         vec_scale(ez, zsign * fz)))
+            body = toes if on_toes else calc
+            local = tf_point(tf_inv(x[body]), world)
+            contacts.setdefault(body, []).append(("contact_%s_%d" % (side, k), local, r))
+            points.append([world[0], sole, world[2]])
+    return contacts, points, sole
+
+
+def standing_pose(model, zero, frames):
+    """The `standing` pose (= qpos0) and the contact spheres, computed (mjmodels/README.md,
+    "Standing pose"):
+    1. pelvic tilt relative to the legs and lumbar_extension: the means over the IK trial;
+       other coordinates 0 (right knee's secondary coordinates at their defaults), knees 0,
+       ankle_angle = subtalar_angle = 0;
+    2. per leg, hip_flexion and hip_adduction such that the ankle centre (talus origin) lies
+       vertically below the hip centre (femur origin) with the pelvis at the trial's mean tilt
+       (legs vertical), hip_rotation such that the foot axis (calcaneus origin -> mtp centre)
+       points straight ahead (X);
+    3. the whole body leans forward by `lean` about the feet (pelvis_rz = mean tilt - lean, hips
+       as in 2, so the legs lean with it); for each lean the contact spheres are placed level
+       at that pose (contact_spheres) and lean is solved (bisection) so that the whole-body COM
+       lies over the middle of the fore-aft span of the 12 contact points;
+    4. pelvis_ty such that the sole is at height 0 (every sphere bottom touches the floor).
+    Returns (pose, {body: [(geom name, local position, radius)]}, report dict)."""
+    pose = dict(zero)
+    tilt = sum(f[1]["pelvis_rz"] for f in frames) / len(frames)
+    pose["pelvis_rz"] = tilt
+    pose["lumbar_extension"] = sum(f[1]["lumbar_extension"] for f in frames) / len(frames)
+
+    def xform(p):
+        return model.body_transforms(model.coordinate_values(p))
+
+    # legs vertical (ankle centre below the hip centre, sagittal and frontal) and feet pointing
+    # straight ahead (foot axis calcaneus -> mtp along X): coordinate-wise bisection, 3 sweeps
+    for _ in range(3):
+        for sfx, femur, talus, calc, toes in (("", "femur", "talus", "calcaneus", "toes"),
+                                              ("_l", "femur_l", "talus_l", "calcaneus_l",
+                                               "toes_l")):
+            for coord, err in (
+                    ("hip_rotation", lambda x: x[toes][1][2] - x[calc][1][2]),
+                    ("hip_flexion", lambda x: x[talus][1][0] - x[femur][1][0]),
+                    ("hip_adduction", lambda x: x[talus][1][2] - x[femur][1][2])):
+                def f(q, c=coord + sfx, e=err):
+                    p = dict(pose)
+                    p[c] = q
+                    return e(xform(p))
+                pose[coord + sfx] = bisect(f, -0.6, 0.6)
+    def com_ahead(lean):
+        p = dict(pose)
+        p["pelvis_rz"] = tilt - lean
+        x = xform(p)
+        _, points, _ = contact_spheres(model, x)
+        xs = [q[0] for q in points]
+        return whole_body_com(model, x)[0] - 0.5 * (min(xs) + max(xs))
+    lean = bisect(com_ahead, -0.3, 0.3)
+    pose["pelvis_rz"] = tilt - lean
+    contacts, points, sole = contact_spheres(model, xform(pose))
+    pose["pelvis_ty"] = -sole
+    x = xform(pose)
+    com = whole_body_com(model, x)
+    points = [[q[0], 0.0, q[2]] for q in points]
+    report = {"com": com, "points": points, "lean": lean, "tilt": tilt,
+              "ankle_r": x["talus"][1], "ankle_l": x["talus_l"][1]}
+    return pose, contacts, report
+
+
 class Converter:
     def __init__(self, model, metabolic, frames, osim_name):
         self.model = model
@@ -945,10 +1060,15 @@ class Converter:
         self.frames = frames
         self.osim_name = osim_name
         # reference (default) pose: OpenSim defaults of the knee's secondary coordinates, 0 else
-        self.defaults = {c: model.default_value(c) if c in KNEE_SECONDARY else 0.0
-                         for c in MODEL_COORDINATES}
+        zero = {c: model.default_value(c) if c in KNEE_SECONDARY else 0.0
+                for c in MODEL_COORDINATES}
+        # the OpenSim default pose: wrap segments and patella placement are chosen there
+        self.x0 = model.body_transforms(model.coordinate_values(zero))
+        # the standing pose is the model's reference configuration: qpos0 = `ref` = standing,
+        # so stock tools start standing (mjmodels/README.md, "Standing pose")
+        self.standing, self.contacts, self.standing_report = standing_pose(model, zero, frames)
+        self.defaults = self.standing
         self.values0 = model.coordinate_values(self.defaults)
-        self.x0 = model.body_transforms(self.values0)
         self.children = {}
         for j, rev in model.tree:
             child = j["parent"] if rev else j["child"]
@@ -1089,28 +1209,9 @@ class Converter:
         for name, pos in self.sites.get(body, []):
             cls = "side" if name.endswith("_side") else "path"
             out.append('%s<site name="%s" class="%s" pos="%s"/>' % (pad, name, cls, fvec(pos)))
-        for side, calc, toes in (("r", "calcaneus", "toes"), ("l", "calcaneus_l", "toes_l")):
-            if body not in (calc, toes):
-                continue
-            for k, x, y, z, r in CONTACT_SPHERES:
-                on_toes = k >= 5
-                if (body == toes) != on_toes:
-                    continue
-                p = [x, y, z if side == "r" else -z]
-                if on_toes:
-                    p = tf_point(tf_mul(tf_inv(self.x0[toes]), self.x0[calc]), p)
-                out.append('%s<geom name="contact_%s_%d" class="contact" size="%s" pos="%s"/>'
-                           % (pad, side, k, fmt(r), fvec(p, 6)))
-
-    def standing_height(self):
-        """pelvis_ty that puts the lowest contact sphere on the floor (all else at default)."""
-        lowest = None
-        for calc, toes, zs in (("calcaneus", "toes", 1.0), ("calcaneus_l", "toes_l", -1.0)):
-            for k, x, y, z, r in CONTACT_SPHERES:
-                p = tf_point(self.x0[calc], [x, y, zs * z])
-                h = p[1] - r
-                lowest = h if lowest is None else min(lowest, h)
-        return -lowest
+        for name, pos, r in self.contacts.get(body, []):
+            out.append('%s<geom name="%s" class="contact" size="%s" pos="%s"/>'
+                       % (pad, name, fmt(r), fvec(pos, 6)))
 
     def lengthranges(self):
         out = {}
@@ -1158,7 +1259,10 @@ class Converter:
         out.append('  <option timestep="0.001" gravity="0 0 -9.80665" integrator="Euler"/>')
         out.append('  <size nuser_actuator="12" nuser_geom="6"/>')
         out.append("  <default>")
-        out.append('    <joint armature="0" damping="0"/>')
+        # stiff joint limits (README "Joint limits"): a held (zero-width range) ankle must carry
+        # the body's gravity moment without creeping
+        out.append('    <joint armature="0" damping="0" solreflimit="0.004 1"'
+                   ' solimplimit="0.95 0.99 0.001"/>')
         out.append('    <geom contype="0" conaffinity="0" group="1"/>')
         out.append('    <site size="0.004" group="4"/>')
         out.append('    <default class="wrap">')
@@ -1206,7 +1310,7 @@ class Converter:
         out.append("  </actuator>")
         qpos = []
         for c in MODEL_COORDINATES:
-            qpos.append(self.standing_height() if c == "pelvis_ty" else self.defaults[c])
+            qpos.append(self.standing[c])
         out.append("  <keyframe>")
         out.append('    <key name="standing" qpos="%s"/>' % fvec(qpos))
         out.append("  </keyframe>")

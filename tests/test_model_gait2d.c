@@ -85,7 +85,7 @@ int main(void) {
   mjData* d = mj_makeData(m);
   if (key >= 0) {
     mj_resetDataKeyframe(m, d, key);
-    EXPECT_NEAR(1.0413, d->qpos[1], 1e-3);  // pelvis_ty as in jw_fullbody.xml
+    EXPECT_NEAR(1.0230, d->qpos[1], 1e-3);  // pelvis_ty as in jw_fullbody.xml
     mj_fwdPosition(m, d);
     for (int a = 0; a < m->nu; a++) {
       double best = 0;
@@ -99,16 +99,18 @@ int main(void) {
                 mj_id2name(m, mjOBJ_ACTUATOR, a), best);
       }
     }
-    // the lowest contact sphere touches the floor (z = 0) within 1 mm
-    double low = 1e9;
+    // every contact sphere touches the floor (z = 0) within 1 mm: level feet (mjmodels/README.md)
+    double low = 1e9, high = -1e9;
     for (int g = 0; g < m->ngeom; g++) {
       const char* name = mj_id2name(m, mjOBJ_GEOM, g);
       if (name && !strncmp(name, "contact_", 8)) {
         double z = d->geom_xpos[3 * g + 2] - m->geom_size[3 * g];
         low = z < low ? z : low;
+        high = z > high ? z : high;
       }
     }
     EXPECT_NEAR(0.0, low, 1e-3);
+    EXPECT_NEAR(0.0, high, 1e-3);
   }
 
   mj_deleteData(d);

@@ -8,5 +8,6 @@ const gsCommand gs_commands[] = {
     {"info", gs_cmd_info, "summarise a model: degrees of freedom, muscles, contacts, mass"},
     {"simulate", gs_cmd_simulate, "forward simulation with gaitsim's muscles and foot contact"},
     {"inspect", gs_cmd_inspect, "one row per muscle at one instant: lengths, force, metabolics, moment arms"},
+    {"track", gs_cmd_track, "tracking solve of one stride by direct collocation"},
     {NULL, NULL, NULL},
 };

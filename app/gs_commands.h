@@ -15,6 +15,7 @@ typedef struct gsCommand_ {
 int gs_cmd_info(int argc, char** argv);
 int gs_cmd_run(int argc, char** argv);
 int gs_cmd_simulate(int argc, char** argv);
+int gs_cmd_track(int argc, char** argv);
 int gs_cmd_inspect(int argc, char** argv);
 
 // The table of subcommands, terminated by an entry with name NULL.

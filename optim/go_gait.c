@@ -1,0 +1,851 @@
+// go_gait.c: the gait collocation problem (see go_gait.h).
+#include "optim/go_gait.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "callbacks/gs_activation.h"
+#include "callbacks/gs_model_info.h"
+#include "callbacks/gs_muscle.h"
+#include "callbacks/gs_physics.h"
+#include "optim/go_jacobian.h"
+
+// variable scales (physical units per solver unit)
+#define SC_Q 1.0
+#define SC_QD 5.0
+#define SC_QDD 50.0
+#define SC_ADOT 20.0
+#define SC_FTDOT 10.0
+// tracking error scales
+#define TR_ROT (5.0 * M_PI / 180.0)  // rad
+#define TR_TRANS 0.02                // m
+#define TR_GRF 0.1                   // body weights
+// moment arm magnitude that counts as crossing (m or m/rad)
+#define CROSS_TOL 1e-9
+#define CROSS_RANDOM_POSES 64
+
+// per-worker context: one mjData and scratch
+typedef struct {
+  const go_gait* g;   // the problem (read only)
+  mjData* d;          // this worker's data
+  double* M;          // full mass matrix (nv x nv)
+} gait_ctx;
+
+struct go_gait {
+  mjModel* m;                 // private copy, constraint stage off
+  go_gait_layout L;           // layout
+  int N;                      // nodes
+  double T;                   // stride time (s)
+  double weight;              // m g (N)
+  gsMuscleParams* mprm;       // muscle parameters (na)
+  gsActivationParams* aprm;   // activation parameters (na)
+  int* elastic;               // (ne)
+  int* elastic_of;            // (na)
+  unsigned char* cross;       // muscle i crosses dof j: cross[i nv + j] (na x nv)
+  unsigned char* tree;        // dofs i, j on one branch: tree[i nv + j] (nv x nv)
+  unsigned char* foot;        // dof j moves foot s: foot[s nv + j] (2 x nv)
+  int* col_ptr;               // path pattern (nz + 1)
+  int* row_idx;               // (nnz)
+  unsigned char* analytic;    // (nz)
+  double* z_lb;               // (nz)
+  double* z_ub;               // (nz)
+  double* z_scale;            // (nz)
+  double* path_scale;         // (n_path)
+  int n_bnd;                  // boundary rows
+  int* bnd_var;               // periodic node variable of boundary row b (n_bnd; -1: speed)
+  int* bnd_col_ptr;           // (2 nz + 2)
+  int* bnd_row_idx;           // (2 n_bnd)
+  double* bnd_scale;          // (n_bnd)
+  double speed;               // speed constraint (m/s), 0: none
+  double* q_ref;              // measured coordinates (N x nv), NAN when absent
+  double* grf_ref;            // measured grf, world (N x 6), NAN when absent
+  double* q_wt;               // tracking weight / scale^2 / count per dof (nv)
+  double w_grf;               // grf weight / scale^2 / 6
+  double w_effort;            // effort weight / na
+  int* ivars;                 // integrand variables
+  int n_ivars;
+  gait_ctx* ctx;              // (nthreads)
+  void** ctx_ptr;             // (nthreads)
+  int nthreads;
+  go_nlp* nlp;                // the NLP
+};
+
+void go_gait_opts_default(go_gait_opts* o) {
+  memset(o, 0, sizeof(*o));
+  o->N = 40;
+  o->nthreads = 1;
+  o->w_pelvis_rot = 1.0;
+  o->w_pelvis_trans = 1.0;
+  o->w_joint = 1.0;
+  o->w_grf = 1.0;
+  o->w_effort = 0.1;
+  o->periodic = 1;
+}
+
+go_nlp* go_gait_nlp(go_gait* g) { return g->nlp; }
+const go_gait_layout* go_gait_layout_get(const go_gait* g) { return &g->L; }
+const mjModel* go_gait_model(const go_gait* g) { return g->m; }
+int go_gait_nodes(const go_gait* g) { return g->N; }
+double go_gait_stride_time(const go_gait* g) { return g->T; }
+double go_gait_weight(const go_gait* g) { return g->weight; }
+double go_gait_q_ref(const go_gait* g, int k, int j) { return g->q_ref[k * g->L.nv + j]; }
+double go_gait_grf_ref(const go_gait* g, int k, int c) {
+  return g->grf_ref[k * GO_GAIT_NGRF + c];
+}
+
+// --- evaluation -------------------------------------------------------------------------------
+
+void go_gait_load_node(const go_gait* g, mjData* d, const double* z) {
+  const go_gait_layout* L = &g->L;
+  const mjModel* m = g->m;
+  mju_copy(d->qpos, z + L->x_q, L->nv);
+  mju_copy(d->qvel, z + L->x_qd, L->nv);
+  mju_copy(d->qacc, z + L->xd_qdd, L->nv);
+  mju_copy(d->act, z + L->x_a, L->na);
+  mju_copy(d->ctrl, z + L->u_e, L->na);
+  mju_zero(d->userdata, m->nuserdata);
+  for (int e = 0; e < L->ne; e++) {
+    d->userdata[L->elastic[e]] = z[L->x_ft + e];
+  }
+  mj_inverse(m, d);
+}
+
+// tension (N) of muscle i at the loaded state; dF/da into *dFda for rigid tendons (else 0)
+static double tension(const go_gait* g, const mjData* d, const double* z, int i, double* dFda) {
+  const gsMuscleParams* p = &g->mprm[i];
+  int e = g->L.elastic_of[i];
+  if (e >= 0) {
+    *dFda = 0;
+    return p->fmax * z[g->L.x_ft + e];
+  }
+  gsMuscleGrad gr;
+  double F = gs_muscle_rigid_force(p, z[g->L.x_a + i], d->actuator_length[i],
+                                   d->actuator_velocity[i], &gr, NULL);
+  *dFda = gr.a;
+  return F;
+}
+
+int go_gait_path_eval(const go_gait* g, mjData* d, const double* z, double* res) {
+  const go_gait_layout* L = &g->L;
+  const mjModel* m = g->m;
+  int nv = L->nv;
+  go_gait_load_node(g, d, z);
+  // link rows
+  for (int j = 0; j < nv; j++) {
+    res[L->r_link + j] = z[L->x_qd + j] - z[L->xd_q + j];
+  }
+  // equations of motion: inverse dynamics minus muscle generalized forces
+  double* eom = res + L->r_eom;
+  mju_copy(eom, d->qfrc_inverse, nv);
+  for (int i = 0; i < L->na; i++) {
+    double dFda;
+    double F = tension(g, d, z, i, &dFda);
+    const mjtNum* mom = d->actuator_moment + i * nv;
+    for (int j = 0; j < nv; j++) {
+      if (g->cross[i * nv + j]) {
+        eom[j] += mom[j] * F;
+      }
+    }
+  }
+  // Hill equilibrium of elastic muscles
+  for (int e = 0; e < L->ne; e++) {
+    int i = L->elastic[e];
+    res[L->r_hill + e] = gs_muscle_equilibrium_residual(
+        &g->mprm[i], z[L->x_a + i], d->actuator_length[i], d->actuator_velocity[i],
+        z[L->x_ft + e], z[L->xd_ft + e], NULL, NULL);
+  }
+  // activation dynamics
+  for (int i = 0; i < L->na; i++) {
+    res[L->r_act + i] = z[L->xd_a + i] -
+                        gs_activation_dot(&g->aprm[i], z[L->u_e + i], z[L->x_a + i], NULL, NULL);
+  }
+  // ground reactions
+  for (int s = 0; s < 2; s++) {
+    gsFootGrf fg;
+    gs_physics_foot_grf(m, d, s == 0 ? 'r' : 'l', 5.0, &fg);
+    for (int c = 0; c < 3; c++) {
+      res[L->r_grf + 3 * s + c] = z[L->u_grf + 3 * s + c] - fg.force[c];
+    }
+  }
+  for (int r = 0; r < L->n_path; r++) {
+    if (!isfinite(res[r])) {
+      return -1;
+    }
+  }
+  return 0;
+}
+
+static int path_cb(void* vctx, int k, const double* z, double* res) {
+  gait_ctx* c = (gait_ctx*)vctx;
+  return go_gait_path_eval(c->g, c->d, z, res);
+}
+
+// analytic columns: q', qddot, a, fT, adot, fT', e, grf
+static int path_jac_cb(void* vctx, int k, const double* z, double* vals) {
+  gait_ctx* c = (gait_ctx*)vctx;
+  const go_gait* g = c->g;
+  const go_gait_layout* L = &g->L;
+  int nv = L->nv;
+  mjData* d = c->d;
+  go_gait_load_node(g, d, z);
+  mj_fullM(g->m, c->M, d->qM);
+  for (int col = 0; col < L->nz; col++) {
+    if (!g->analytic[col]) {
+      continue;
+    }
+    int p0 = g->col_ptr[col], p1 = g->col_ptr[col + 1];
+    if (col >= L->xd_q && col < L->xd_q + nv) {  // q': link row
+      vals[p0] = -1.0;
+    } else if (col >= L->xd_qdd && col < L->xd_qdd + nv) {  // qddot: mass matrix
+      int j = col - L->xd_qdd;
+      for (int p = p0; p < p1; p++) {
+        vals[p] = c->M[(g->row_idx[p] - L->r_eom) * nv + j];
+      }
+    } else if (col >= L->x_a && col < L->x_a + L->na) {  // activation
+      int i = col - L->x_a;
+      int e = L->elastic_of[i];
+      double dFda = 0, dda = 0;
+      tension(g, d, z, i, &dFda);
+      gs_activation_dot(&g->aprm[i], z[L->u_e + i], z[L->x_a + i], NULL, &dda);
+      gsMuscleGrad gr = {0};
+      if (e >= 0) {
+        gs_muscle_equilibrium_residual(&g->mprm[i], z[col], d->actuator_length[i],
+                                       d->actuator_velocity[i], z[L->x_ft + e], z[L->xd_ft + e],
+                                       &gr, NULL);
+      }
+      for (int p = p0; p < p1; p++) {
+        int r = g->row_idx[p];
+        if (r < L->r_hill) {
+          vals[p] = d->actuator_moment[i * nv + r - L->r_eom] * dFda;
+        } else if (r < L->r_act) {
+          vals[p] = gr.a;
+        } else {
+          vals[p] = -dda;
+        }
+      }
+    } else if (col >= L->x_ft && col < L->x_ft + L->ne) {  // tendon force
+      int e = col - L->x_ft, i = L->elastic[e];
+      gsMuscleGrad gr;
+      gs_muscle_equilibrium_residual(&g->mprm[i], z[L->x_a + i], d->actuator_length[i],
+                                     d->actuator_velocity[i], z[col], z[L->xd_ft + e], &gr, NULL);
+      for (int p = p0; p < p1; p++) {
+        int r = g->row_idx[p];
+        vals[p] = r < L->r_hill ? d->actuator_moment[i * nv + r - L->r_eom] * g->mprm[i].fmax
+                                : gr.fT;
+      }
+    } else if (col >= L->xd_a && col < L->xd_a + L->na) {  // adot
+      vals[p0] = 1.0;
+    } else if (col >= L->xd_ft && col < L->xd_ft + L->ne) {  // fT'
+      int e = col - L->xd_ft, i = L->elastic[e];
+      gsMuscleGrad gr;
+      gs_muscle_equilibrium_residual(&g->mprm[i], z[L->x_a + i], d->actuator_length[i],
+                                     d->actuator_velocity[i], z[L->x_ft + e], z[col], &gr, NULL);
+      vals[p0] = gr.fT_dot;
+    } else if (col >= L->u_e && col < L->u_e + L->na) {  // excitation
+      int i = col - L->u_e;
+      double ddu = 0;
+      gs_activation_dot(&g->aprm[i], z[col], z[L->x_a + i], &ddu, NULL);
+      vals[p0] = -ddu;
+    } else {  // grf variable
+      vals[p0] = 1.0;
+    }
+  }
+  for (int col = 0; col < L->nz; col++) {
+    for (int p = g->col_ptr[col]; g->analytic[col] && p < g->col_ptr[col + 1]; p++) {
+      if (!isfinite(vals[p])) {
+        return -1;
+      }
+    }
+  }
+  return 0;
+}
+
+// --- objective --------------------------------------------------------------------------------
+
+static int integrand_cb(void* vctx, int k, const double* z, double* out) {
+  const go_gait* g = ((gait_ctx*)vctx)->g;
+  const go_gait_layout* L = &g->L;
+  double s = 0;
+  for (int j = 0; j < L->nv; j++) {
+    if (g->q_wt[j] > 0) {
+      double err = z[L->x_q + j] - g->q_ref[k * L->nv + j];
+      s += g->q_wt[j] * err * err;
+    }
+  }
+  if (g->w_grf > 0) {
+    for (int c = 0; c < GO_GAIT_NGRF; c++) {
+      double err = z[L->u_grf + c] - g->grf_ref[k * GO_GAIT_NGRF + c];
+      s += g->w_grf * err * err;
+    }
+  }
+  for (int i = 0; i < L->na; i++) {
+    s += g->w_effort * z[L->u_e + i] * z[L->u_e + i];
+  }
+  *out = s;
+  return isfinite(s) ? 0 : -1;
+}
+
+static int integrand_grad_cb(void* vctx, int k, const double* z, double* dL) {
+  const go_gait* g = ((gait_ctx*)vctx)->g;
+  const go_gait_layout* L = &g->L;
+  memset(dL, 0, sizeof(double) * (size_t)L->nz);
+  for (int j = 0; j < L->nv; j++) {
+    if (g->q_wt[j] > 0) {
+      dL[L->x_q + j] = 2 * g->q_wt[j] * (z[L->x_q + j] - g->q_ref[k * L->nv + j]);
+    }
+  }
+  if (g->w_grf > 0) {
+    for (int c = 0; c < GO_GAIT_NGRF; c++) {
+      dL[L->u_grf + c] = 2 * g->w_grf * (z[L->u_grf + c] - g->grf_ref[k * GO_GAIT_NGRF + c]);
+    }
+  }
+  for (int i = 0; i < L->na; i++) {
+    dL[L->u_e + i] = 2 * g->w_effort * z[L->u_e + i];
+  }
+  return 0;
+}
+
+static int outer_cb(void* ctx, double I, double T, double* J, double* dJdI, double* dJdT) {
+  *J = I / T;
+  *dJdI = 1.0 / T;
+  *dJdT = -I / (T * T);
+  return 0;
+}
+
+// --- boundary ---------------------------------------------------------------------------------
+
+static int boundary_cb(void* vctx, const double* z0, const double* z1, double T, double* b) {
+  const go_gait* g = ((gait_ctx*)vctx)->g;
+  for (int r = 0; r < g->n_bnd; r++) {
+    int v = g->bnd_var[r];
+    b[r] = v >= 0 ? z1[v] - z0[v]
+                  : (z1[g->L.x_q + g->L.tx] - z0[g->L.x_q + g->L.tx]) / T - g->speed;
+  }
+  return 0;
+}
+
+// --- set-up -----------------------------------------------------------------------------------
+
+// 1 if dof a is dof b or one of its ancestors
+static int dof_ancestor(const mjModel* m, int a, int b) {
+  for (int x = b; x >= 0; x = m->dof_parentid[x]) {
+    if (x == a) {
+      return 1;
+    }
+  }
+  return 0;
+}
+
+// deterministic uniform in [-1, 1]
+static double lcg(unsigned long long* s) {
+  *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
+  return ((double)(*s >> 11) / 9007199254740992.0) * 2.0 - 1.0;
+}
+
+// crossing matrix over the trial poses and random poses around them
+static void crossing(go_gait* g, const gsTable* coords, const int* qcol) {
+  const mjModel* m = g->m;
+  int nv = m->nv, na = g->L.na;
+  mjData* d = mj_makeData(m);
+  int nrow = coords ? coords->nrow : 1;
+  unsigned long long seed = 12345;
+  for (int pose = 0; pose < nrow + CROSS_RANDOM_POSES; pose++) {
+    int row = pose < nrow ? pose : (int)((lcg(&seed) + 1) * 0.5 * (nrow - 1) + 0.5);
+    mju_copy(d->qpos, m->qpos0, m->nq);
+    for (int j = 0; coords && j < nv; j++) {
+      if (qcol[j] >= 0) {
+        d->qpos[j] = coords->data[row * coords->ncol + qcol[j]];
+      }
+    }
+    if (pose >= nrow) {
+      for (int j = 0; j < nv; j++) {
+        int jnt = m->dof_jntid[j];
+        d->qpos[j] += (m->jnt_type[jnt] == mjJNT_SLIDE ? 0.03 : 0.35) * lcg(&seed);
+      }
+    }
+    mj_fwdPosition(m, d);
+    for (int i = 0; i < na; i++) {
+      for (int j = 0; j < nv; j++) {
+        if (fabs(d->actuator_moment[i * nv + j]) > CROSS_TOL) {
+          g->cross[i * nv + j] = 1;
+        }
+      }
+    }
+  }
+  mj_deleteData(d);
+}
+
+// the path pattern (compressed columns); returns the number of entries, writes them when the
+// arrays are not NULL
+static int pattern(const go_gait* g, int* col_ptr, int* row_idx) {
+  const go_gait_layout* L = &g->L;
+  int nv = L->nv, n = 0;
+#define PUT(r)                 \
+  do {                         \
+    if (row_idx) row_idx[n] = (r); \
+    n++;                       \
+  } while (0)
+  for (int col = 0; col < L->nz; col++) {
+    if (col_ptr) col_ptr[col] = n;
+    if (col < L->x_qd + nv) {  // q or qdot of dof j
+      int j = col < L->x_qd ? col : col - L->x_qd;
+      if (col >= L->x_qd) PUT(L->r_link + j);
+      for (int r = 0; r < nv; r++) PUT(L->r_eom + r);
+      for (int e = 0; e < L->ne; e++) {
+        if (g->cross[L->elastic[e] * nv + j]) PUT(L->r_hill + e);
+      }
+      for (int s = 0; s < 2; s++) {
+        if (g->foot[s * nv + j]) {
+          for (int c = 0; c < 3; c++) PUT(L->r_grf + 3 * s + c);
+        }
+      }
+    } else if (col < L->x_ft) {  // a
+      int i = col - L->x_a;
+      if (L->elastic_of[i] < 0) {
+        for (int r = 0; r < nv; r++) {
+          if (g->cross[i * nv + r]) PUT(L->r_eom + r);
+        }
+      } else {
+        PUT(L->r_hill + L->elastic_of[i]);
+      }
+      PUT(L->r_act + i);
+    } else if (col < L->xd_q) {  // fT
+      int e = col - L->x_ft, i = L->elastic[e];
+      for (int r = 0; r < nv; r++) {
+        if (g->cross[i * nv + r]) PUT(L->r_eom + r);
+      }
+      PUT(L->r_hill + e);
+    } else if (col < L->xd_qdd) {  // q'
+      PUT(L->r_link + col - L->xd_q);
+    } else if (col < L->xd_a) {  // qddot
+      int j = col - L->xd_qdd;
+      for (int r = 0; r < nv; r++) {
+        if (g->tree[r * nv + j]) PUT(L->r_eom + r);
+      }
+    } else if (col < L->xd_ft) {  // adot
+      PUT(L->r_act + col - L->xd_a);
+    } else if (col < L->u_e) {  // fT'
+      PUT(L->r_hill + col - L->xd_ft);
+    } else if (col < L->u_grf) {  // excitation
+      PUT(L->r_act + col - L->u_e);
+    } else {  // grf
+      PUT(L->r_grf + col - L->u_grf);
+    }
+  }
+  if (col_ptr) col_ptr[L->nz] = n;
+#undef PUT
+  return n;
+}
+
+int go_gait_dof_is_root(const mjModel* m, int j) {
+  int top = j;
+  while (m->dof_parentid[top] >= 0) {
+    top = m->dof_parentid[top];
+  }
+  return m->dof_bodyid[top] == m->dof_bodyid[j];
+}
+
+static void* zalloc(size_t n, size_t size) { return calloc(n > 0 ? n : 1, size); }
+
+void go_gait_free(go_gait* g) {
+  if (!g) {
+    return;
+  }
+  go_nlp_free(g->nlp);
+  for (int w = 0; g->ctx && w < g->nthreads; w++) {
+    if (g->ctx[w].d) mj_deleteData(g->ctx[w].d);
+    free(g->ctx[w].M);
+  }
+  free(g->ctx);
+  free(g->ctx_ptr);
+  if (g->m) mj_deleteModel(g->m);
+  free(g->mprm), free(g->aprm), free(g->elastic), free(g->elastic_of), free(g->cross);
+  free(g->tree), free(g->foot), free(g->col_ptr), free(g->row_idx), free(g->analytic);
+  free(g->z_lb), free(g->z_ub), free(g->z_scale), free(g->path_scale), free(g->bnd_var);
+  free(g->bnd_col_ptr), free(g->bnd_row_idx), free(g->bnd_scale), free(g->q_ref);
+  free(g->grf_ref), free(g->q_wt), free(g->ivars);
+  free(g);
+}
+
+// coordinate column of each dof in t (-1: absent)
+static void coord_columns(const mjModel* m, const gsTable* t, int* col) {
+  for (int j = 0; j < m->nv; j++) {
+    col[j] = t ? gs_table_column(t, mj_id2name(m, mjOBJ_JOINT, m->dof_jntid[j])) : -1;
+  }
+}
+
+// resample the measured data at the node times
+static int references(go_gait* g, const go_gait_opts* o, const int* qcol, char* err, int errsz) {
+  int N = g->N, nv = g->L.nv;
+  for (int q = 0; q < N * nv; q++) g->q_ref[q] = NAN;
+  for (int q = 0; q < N * GO_GAIT_NGRF; q++) g->grf_ref[q] = NAN;
+  double* times = (double*)zalloc((size_t)N, sizeof(double));
+  gsTable rs;
+  gs_table_init(&rs);
+  int status = 0;
+  if (o->coords) {
+    double t0 = o->coords->time[0];
+    for (int k = 0; k < N; k++) times[k] = t0 + g->T * k / (N - 1);
+    if (gs_table_resample(o->coords, times, N, &rs, err, errsz) != 0) {
+      status = -1;
+    }
+    for (int k = 0; status == 0 && k < N; k++) {
+      for (int j = 0; j < nv; j++) {
+        if (qcol[j] >= 0) g->q_ref[k * nv + j] = rs.data[k * rs.ncol + qcol[j]];
+      }
+    }
+  }
+  if (status == 0 && o->grf) {
+    static const char* names[GO_GAIT_NGRF] = {"ground_force_r_vx", "ground_force_r_vy",
+                                              "ground_force_r_vz", "ground_force_l_vx",
+                                              "ground_force_l_vy", "ground_force_l_vz"};
+    gsTable sel;
+    gs_table_init(&sel);
+    double t0 = o->grf->time[0];
+    for (int k = 0; k < N; k++) times[k] = t0 + g->T * k / (N - 1);
+    if (gs_table_select(o->grf, names, GO_GAIT_NGRF, &sel, err, errsz) != 0 ||
+        gs_table_resample(&sel, times, N, &rs, err, errsz) != 0) {
+      status = -1;
+    }
+    for (int k = 0; status == 0 && k < N; k++) {
+      for (int s = 0; s < 2; s++) {  // OpenSim (x, y up, z) -> world (x, -z, y)
+        const double* v = rs.data + k * GO_GAIT_NGRF + 3 * s;
+        double* w = g->grf_ref + k * GO_GAIT_NGRF + 3 * s;
+        w[0] = v[0];
+        w[1] = -v[2];
+        w[2] = v[1];
+      }
+    }
+    gs_table_free(&sel);
+  }
+  gs_table_free(&rs);
+  free(times);
+  return status;
+}
+
+int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char* err,
+                   int errsz) {
+  *out = NULL;
+  if (o->N < 2 || o->nthreads < 1) {
+    snprintf(err, errsz, "go_gait_create: need N >= 2 and nthreads >= 1");
+    return -1;
+  }
+  if (m0->nq != m0->nv || m0->na != m0->nu || m0->nu == 0) {
+    snprintf(err, errsz, "go_gait_create: need nq == nv (no free or ball joints) and an "
+             "activation state for every actuator (nq %d nv %d nu %d na %d)", m0->nq, m0->nv,
+             m0->nu, m0->na);
+    return -1;
+  }
+  if (m0->nuserdata < GS_USERDATA_SIZE(m0)) {
+    snprintf(err, errsz, "go_gait_create: model not prepared (gs_physics_prepare)");
+    return -1;
+  }
+  if (o->coords && o->coords->nrow < 2) {
+    snprintf(err, errsz, "go_gait_create: coordinate table needs 2 rows or more");
+    return -1;
+  }
+  go_gait* g = (go_gait*)calloc(1, sizeof(go_gait));
+  if (!g) {
+    snprintf(err, errsz, "go_gait_create: out of memory");
+    return -1;
+  }
+  g->m = mj_copyModel(NULL, m0);
+  g->m->opt.disableflags |= mjDSBL_CONSTRAINT;
+  const mjModel* m = g->m;
+  int nv = m->nv, na = m->na;
+  g->N = o->N;
+  g->T = o->T > 0 ? o->T
+                  : (o->coords ? o->coords->time[o->coords->nrow - 1] - o->coords->time[0] : 1.0);
+  g->weight = mj_getTotalmass(m) * mju_norm3(m->opt.gravity);
+  g->speed = o->speed > 0 ? o->speed : 0;
+  g->nthreads = o->nthreads;
+
+  // muscles
+  g->mprm = (gsMuscleParams*)zalloc((size_t)na, sizeof(gsMuscleParams));
+  g->aprm = (gsActivationParams*)zalloc((size_t)na, sizeof(gsActivationParams));
+  g->elastic = (int*)zalloc((size_t)na, sizeof(int));
+  g->elastic_of = (int*)zalloc((size_t)na, sizeof(int));
+  int ne = 0;
+  for (int i = 0; i < na; i++) {
+    const double* user = m->actuator_user + i * m->nuser_actuator;
+    char why[256];
+    if (!gs_actuator_is_gaitsim_muscle(m, i) ||
+        gs_muscle_params_from_user(user, &g->mprm[i], why, sizeof(why)) != 0 ||
+        gs_activation_params_from_user(user, &g->aprm[i], why, sizeof(why)) != 0) {
+      snprintf(err, errsz, "go_gait_create: actuator %s is not a valid gaitsim muscle",
+               mj_id2name(m, mjOBJ_ACTUATOR, i));
+      go_gait_free(g);
+      return -1;
+    }
+    g->elastic_of[i] = g->mprm[i].elastic ? ne : -1;
+    if (g->mprm[i].elastic) g->elastic[ne++] = i;
+  }
+
+  // layout
+  go_gait_layout* L = &g->L;
+  L->nv = nv;
+  L->na = na;
+  L->ne = ne;
+  L->nx = 2 * nv + na + ne;
+  L->x_q = 0;
+  L->x_qd = nv;
+  L->x_a = 2 * nv;
+  L->x_ft = 2 * nv + na;
+  L->xd_q = L->nx;
+  L->xd_qdd = L->nx + nv;
+  L->xd_a = L->nx + 2 * nv;
+  L->xd_ft = L->nx + 2 * nv + na;
+  L->u_e = 2 * L->nx;
+  L->u_grf = 2 * L->nx + na;
+  L->nz = 2 * L->nx + na + GO_GAIT_NGRF;
+  L->r_link = 0;
+  L->r_eom = nv;
+  L->r_hill = 2 * nv;
+  L->r_act = 2 * nv + ne;
+  L->r_grf = 2 * nv + ne + na;
+  L->n_path = 2 * nv + ne + na + GO_GAIT_NGRF;
+  L->elastic = g->elastic;
+  L->elastic_of = g->elastic_of;
+  L->tx = -1;
+  int jtx = mj_name2id(m, mjOBJ_JOINT, "pelvis_tx");
+  if (jtx >= 0) L->tx = m->jnt_dofadr[jtx];
+  if (g->speed > 0 && L->tx < 0) {
+    snprintf(err, errsz, "go_gait_create: a speed constraint needs a pelvis_tx coordinate");
+    go_gait_free(g);
+    return -1;
+  }
+  int nz = L->nz;
+
+  // structure: crossing, mass matrix branches, foot chains
+  int* qcol = (int*)zalloc((size_t)nv, sizeof(int));
+  coord_columns(m, o->coords, qcol);
+  g->cross = (unsigned char*)zalloc((size_t)na * nv, 1);
+  g->tree = (unsigned char*)zalloc((size_t)nv * nv, 1);
+  g->foot = (unsigned char*)zalloc((size_t)2 * nv, 1);
+  crossing(g, o->coords, qcol);
+  for (int a = 0; a < nv; a++) {
+    for (int b = 0; b < nv; b++) {
+      g->tree[a * nv + b] = dof_ancestor(m, a, b) || dof_ancestor(m, b, a);
+    }
+  }
+  for (int geom = 0; geom < m->ngeom; geom++) {
+    int side = gs_geom_contact_side(m, geom);
+    if (!side) continue;
+    for (int b = m->geom_bodyid[geom]; b > 0; b = m->body_parentid[b]) {
+      for (int j = m->body_dofadr[b]; j < m->body_dofadr[b] + m->body_dofnum[b]; j++) {
+        g->foot[(side == 'r' ? 0 : 1) * nv + j] = 1;
+      }
+    }
+  }
+  int nnz = pattern(g, NULL, NULL);
+  g->col_ptr = (int*)zalloc((size_t)nz + 1, sizeof(int));
+  g->row_idx = (int*)zalloc((size_t)nnz, sizeof(int));
+  pattern(g, g->col_ptr, g->row_idx);
+  g->analytic = (unsigned char*)zalloc((size_t)nz, 1);
+  for (int c = L->x_a; c < nz; c++) {
+    g->analytic[c] = 1;
+  }
+
+  // references and tracking weights
+  g->q_ref = (double*)zalloc((size_t)g->N * nv, sizeof(double));
+  g->grf_ref = (double*)zalloc((size_t)g->N * GO_GAIT_NGRF, sizeof(double));
+  g->q_wt = (double*)zalloc((size_t)nv, sizeof(double));
+  if (references(g, o, qcol, err, errsz) != 0) {
+    free(qcol);
+    go_gait_free(g);
+    return -1;
+  }
+  int count[3] = {0, 0, 0};  // pelvis rotations, pelvis translations, others
+  for (int j = 0; j < nv; j++) {
+    if (qcol[j] < 0) continue;
+    int slide = m->jnt_type[m->dof_jntid[j]] == mjJNT_SLIDE;
+    count[go_gait_dof_is_root(m, j) ? (slide ? 1 : 0) : 2]++;
+  }
+  for (int j = 0; j < nv; j++) {
+    if (qcol[j] < 0) continue;
+    int slide = m->jnt_type[m->dof_jntid[j]] == mjJNT_SLIDE;
+    int grp = go_gait_dof_is_root(m, j) ? (slide ? 1 : 0) : 2;
+    double w = grp == 0 ? o->w_pelvis_rot : grp == 1 ? o->w_pelvis_trans : o->w_joint;
+    double sc = slide ? TR_TRANS : TR_ROT;
+    g->q_wt[j] = w / (sc * sc) / count[grp];
+  }
+  double grf_sc = TR_GRF * g->weight;
+  g->w_grf = o->grf ? o->w_grf / (grf_sc * grf_sc) / GO_GAIT_NGRF : 0;
+  g->w_effort = o->w_effort / na;
+  g->ivars = (int*)zalloc((size_t)nz, sizeof(int));
+  for (int j = 0; j < nv; j++) {
+    if (g->q_wt[j] > 0) g->ivars[g->n_ivars++] = L->x_q + j;
+  }
+  for (int i = 0; i < na; i++) g->ivars[g->n_ivars++] = L->u_e + i;
+  if (g->w_grf > 0) {
+    for (int c = 0; c < GO_GAIT_NGRF; c++) g->ivars[g->n_ivars++] = L->u_grf + c;
+  }
+
+  // bounds and scales
+  g->z_lb = (double*)zalloc((size_t)nz, sizeof(double));
+  g->z_ub = (double*)zalloc((size_t)nz, sizeof(double));
+  g->z_scale = (double*)zalloc((size_t)nz, sizeof(double));
+  for (int j = 0; j < nv; j++) {
+    int jnt = m->dof_jntid[j];
+    int slide = m->jnt_type[jnt] == mjJNT_SLIDE;
+    double lo = -M_PI, hi = M_PI;
+    if (m->jnt_limited[jnt]) {
+      lo = m->jnt_range[2 * jnt];
+      hi = m->jnt_range[2 * jnt + 1];
+    } else if (go_gait_dof_is_root(m, j)) {
+      double mn = HUGE_VAL, mx = -HUGE_VAL;
+      for (int k = 0; k < g->N; k++) {
+        double v = g->q_ref[k * nv + j];
+        if (isfinite(v)) {
+          mn = fmin(mn, v);
+          mx = fmax(mx, v);
+        }
+      }
+      double margin = 0.5;
+      lo = isfinite(mn) ? mn - margin : (slide ? -10 : -M_PI);
+      hi = isfinite(mx) ? mx + margin : (slide ? 10 : M_PI);
+    }
+    g->z_lb[L->x_q + j] = lo;
+    g->z_ub[L->x_q + j] = hi;
+    g->z_scale[L->x_q + j] = SC_Q;
+    g->z_lb[L->x_qd + j] = g->z_lb[L->xd_q + j] = -20;
+    g->z_ub[L->x_qd + j] = g->z_ub[L->xd_q + j] = 20;
+    g->z_scale[L->x_qd + j] = g->z_scale[L->xd_q + j] = SC_QD;
+    g->z_lb[L->xd_qdd + j] = -500;
+    g->z_ub[L->xd_qdd + j] = 500;
+    g->z_scale[L->xd_qdd + j] = SC_QDD;
+  }
+  for (int i = 0; i < na; i++) {
+    g->z_lb[L->x_a + i] = g->z_lb[L->u_e + i] = GS_ACTIVATION_MIN;
+    g->z_ub[L->x_a + i] = g->z_ub[L->u_e + i] = GS_ACTIVATION_MAX;
+    g->z_scale[L->x_a + i] = g->z_scale[L->u_e + i] = 1;
+    g->z_lb[L->xd_a + i] = -1000;
+    g->z_ub[L->xd_a + i] = 1000;
+    g->z_scale[L->xd_a + i] = SC_ADOT;
+  }
+  for (int e = 0; e < ne; e++) {
+    g->z_lb[L->x_ft + e] = 0;
+    g->z_ub[L->x_ft + e] = 5;
+    g->z_scale[L->x_ft + e] = 1;
+    g->z_lb[L->xd_ft + e] = -1000;
+    g->z_ub[L->xd_ft + e] = 1000;
+    g->z_scale[L->xd_ft + e] = SC_FTDOT;
+  }
+  for (int c = 0; c < GO_GAIT_NGRF; c++) {
+    g->z_lb[L->u_grf + c] = -10 * g->weight;
+    g->z_ub[L->u_grf + c] = 10 * g->weight;
+    g->z_scale[L->u_grf + c] = g->weight;
+  }
+  g->path_scale = (double*)zalloc((size_t)L->n_path, sizeof(double));
+  for (int j = 0; j < nv; j++) {
+    g->path_scale[L->r_link + j] = SC_QD;
+    g->path_scale[L->r_eom + j] = g->weight;  // m g x 1 m (N m), or N for slides
+  }
+  for (int e = 0; e < ne; e++) g->path_scale[L->r_hill + e] = 1;
+  for (int i = 0; i < na; i++) g->path_scale[L->r_act + i] = SC_ADOT;
+  for (int c = 0; c < GO_GAIT_NGRF; c++) g->path_scale[L->r_grf + c] = g->weight;
+
+  // boundary: periodic states (but pelvis_tx and free coordinates), excitations, speed
+  unsigned char* periodic = (unsigned char*)zalloc((size_t)nz, 1);
+  if (o->periodic) {
+    for (int v = 0; v < L->nx; v++) periodic[v] = 1;
+    for (int i = 0; i < na; i++) periodic[L->u_e + i] = 1;
+    if (L->tx >= 0) periodic[L->x_q + L->tx] = 0;
+    for (int f = 0; o->free_coords && o->free_coords[f]; f++) {
+      int jnt = mj_name2id(m, mjOBJ_JOINT, o->free_coords[f]);
+      if (jnt < 0) {
+        snprintf(err, errsz, "go_gait_create: free coordinate %s is not in the model",
+                 o->free_coords[f]);
+        free(periodic);
+        free(qcol);
+        go_gait_free(g);
+        return -1;
+      }
+      periodic[L->x_q + m->jnt_dofadr[jnt]] = 0;
+    }
+  }
+  int nb = 0;
+  for (int v = 0; v < nz; v++) nb += periodic[v];
+  g->n_bnd = nb + (g->speed > 0);
+  g->bnd_var = (int*)zalloc((size_t)g->n_bnd, sizeof(int));
+  g->bnd_scale = (double*)zalloc((size_t)g->n_bnd, sizeof(double));
+  g->bnd_col_ptr = (int*)zalloc((size_t)2 * nz + 2, sizeof(int));
+  g->bnd_row_idx = (int*)zalloc((size_t)2 * g->n_bnd + 2, sizeof(int));
+  int* row_of = (int*)zalloc((size_t)nz, sizeof(int));
+  nb = 0;
+  for (int v = 0; v < nz; v++) {
+    row_of[v] = -1;
+    if (periodic[v]) {
+      row_of[v] = nb;
+      g->bnd_var[nb] = v;
+      g->bnd_scale[nb++] = g->z_scale[v];
+    }
+  }
+  if (g->speed > 0) {
+    g->bnd_var[nb] = -1;
+    g->bnd_scale[nb] = 1.0;
+  }
+  int nbe = 0;
+  for (int half = 0; half < 2; half++) {
+    for (int v = 0; v < nz; v++) {
+      g->bnd_col_ptr[half * nz + v] = nbe;
+      if (row_of[v] >= 0) g->bnd_row_idx[nbe++] = row_of[v];
+      if (g->speed > 0 && v == L->x_q + L->tx) g->bnd_row_idx[nbe++] = nb;
+    }
+  }
+  g->bnd_col_ptr[2 * nz] = nbe;
+  g->bnd_col_ptr[2 * nz + 1] = nbe;
+  free(row_of);
+  free(periodic);
+  free(qcol);
+
+  // worker contexts
+  g->ctx = (gait_ctx*)zalloc((size_t)g->nthreads, sizeof(gait_ctx));
+  g->ctx_ptr = (void**)zalloc((size_t)g->nthreads, sizeof(void*));
+  for (int w = 0; w < g->nthreads; w++) {
+    g->ctx[w].g = g;
+    g->ctx[w].d = mj_makeData(m);
+    g->ctx[w].M = (double*)zalloc((size_t)nv * nv, sizeof(double));
+    g->ctx_ptr[w] = &g->ctx[w];
+    if (!g->ctx[w].d || !g->ctx[w].M) {
+      snprintf(err, errsz, "go_gait_create: out of memory");
+      go_gait_free(g);
+      return -1;
+    }
+  }
+
+  // the NLP
+  go_problem p;
+  memset(&p, 0, sizeof(p));
+  p.dims = (go_dims){g->N, L->nx, na + GO_GAIT_NGRF, L->n_path, g->n_bnd, 0};
+  p.z_lb = g->z_lb;
+  p.z_ub = g->z_ub;
+  p.T = g->T;
+  p.z_scale = g->z_scale;
+  p.path_scale = g->path_scale;
+  p.boundary_scale = g->bnd_scale;
+  p.obj_scale = 1.0;
+  p.path = path_cb;
+  p.path_col_ptr = g->col_ptr;
+  p.path_row_idx = g->row_idx;
+  p.path_jac = path_jac_cb;
+  p.path_analytic = g->analytic;
+  p.integrand = integrand_cb;
+  p.integrand_vars = g->ivars;
+  p.n_integrand_vars = g->n_ivars;
+  p.integrand_grad = integrand_grad_cb;
+  p.outer = outer_cb;
+  p.boundary = g->n_bnd > 0 ? boundary_cb : NULL;
+  p.bnd_col_ptr = g->bnd_col_ptr;
+  p.bnd_row_idx = g->bnd_row_idx;
+  p.thread_ctx = g->ctx_ptr;
+  p.nthreads = g->nthreads;
+  if (go_nlp_create(&g->nlp, &p, err, errsz) != 0) {
+    go_gait_free(g);
+    return -1;
+  }
+  *out = g;
+  return 0;
+}

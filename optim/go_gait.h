@@ -1,0 +1,143 @@
+// go_gait.h: the gait collocation problem (DESIGN.md, "Formulation choices") on the engine
+// (go_collocation.h): full-body, muscle-driven, implicit multibody dynamics, one stride.
+//
+// Node variables z_k = [x | xdot | u] (go_collocation.h), with
+//   x    = [q (nv) | qdot (nv) | a (na) | fT (ne)]      coordinates (rad, m), speeds, activations,
+//                                                       normalised tendon forces of the ne
+//                                                       elastic-tendon muscles
+//   xdot = [q' (nv) | qddot (nv) | adot (na) | fT' (ne)]
+//   u    = [e (na) | grf (6)]                           excitations; ground reaction force of the
+//                                                       right then left foot, world frame (N)
+// The engine's state derivative of q is a separate variable q' from the state qdot: path rows
+// qdot - q' = 0 tie them (linear, analytic -1 column; the qdot column is finite-differenced with
+// the others and is exact since the row is linear). We chose these rows over a deriv_idx map in
+// the engine because the engine is done and tested; they cost nv rows and 2 nv nonzeros per node.
+//
+// Path rows per node, [link (nv) | eom (nv) | hill (ne) | act (na) | grf (6)]:
+//   link  qdot - q'                                                        (rad/s, m/s)
+//   eom   mj_inverse(q, qdot, qddot).qfrc_inverse + actuator_moment^T tension    (N m, N)
+//         (qfrc_inverse runs mjcb_passive: the foot contact; all nv rows, pelvis included: no
+//         residual actuators; mj_inverse's constraint stage is off in the private model copy,
+//         joint ranges are variable bounds instead)
+//   hill  gs_muscle_equilibrium_residual(a, lMT, vMT, fT, fT') for each elastic muscle     (-)
+//   act   adot - gs_activation_dot(e, a)                                             (1/s)
+//   grf   grf - gs_physics_foot_grf(q, qdot).force, per foot                           (N)
+// Tension: elastic Fmax fT; rigid gs_muscle_rigid_force(a, lMT, vMT).
+//
+// Derivatives: analytic columns q' (-1), qddot (mass matrix M from mj_fullM after mj_inverse),
+// a (rigid: moment dF/da; act row), fT (moment Fmax; hill row), adot, fT', e, grf. Central
+// differences for the q and qdot columns only (2 nv colour groups, the eom rows being dense in
+// them). Pattern per node: eom rows dense in q and qdot; qddot columns of the eom rows where the
+// two dofs are on one branch of the kinematic tree (M's structure); a muscle's eom rows, and its
+// hill row's q and qdot columns, are the coordinates it crosses: |actuator_moment| > 1e-9 at any
+// of the trial poses or at 64 random poses around them (+-0.35 rad, +-0.03 m on every
+// coordinate, fixed seed): the perturbations are the safety margin for moment arms that vanish at
+// some poses (wrapping). Grf rows: q and qdot of the dofs on the path from the world to the
+// foot's contact spheres.
+//
+// Scaling (Ipopt sees O(1)): q 1, qdot and q' 5, qddot 50, a and e 1, adot 20, fT 1, fT' 10,
+// grf m g; rows: link 5, eom m g * 1 m (N m; N for slides), hill 1, act 20, grf m g; periodicity
+// rows as their variable, speed row 1 m/s; objective 1.
+//
+// Objective J = I / T, I = trapezoidal integral of (means over each group of terms)
+//   w_pelvis_rot ((q - q_meas)/5 deg)^2 + w_pelvis_trans ((q - q_meas)/2 cm)^2
+//   + w_joint ((q - q_meas)/(5 deg or 2 cm))^2 + w_grf ((grf - grf_meas)/(0.1 m g))^2
+//   + w_effort e^2
+// over the coordinates present in the measured table (pelvis: the dofs of the root body), with an
+// analytic gradient. Hook for the predictive problem: cost of transport (metabolic rate / (dx m))
+// would enter as another integrand term and outer(); not done here.
+//
+// Boundary: periodicity of every state but pelvis_tx (and the coordinates named in free_coords),
+// and of the excitations; optionally mean speed (tx_last - tx_first) / T = speed.
+// Bounds: a, e in [0.001, 1]; fT in [0, 5]; q within joint ranges (limited joints), root dofs
+// within the measured range +- 0.5 rad / 0.5 m, others +-pi; qdot, q' +-20; qddot +-500;
+// adot +-1000; fT' +-1000; grf +-10 m g.
+//
+// Threads: one mjData (the model's nuserdata) per engine worker; results are bitwise identical
+// for any number of threads (the engine's rule).
+#ifndef GAITSIM_OPTIM_GO_GAIT_H_
+#define GAITSIM_OPTIM_GO_GAIT_H_
+
+#include <mujoco/mujoco.h>
+
+#include "io/gs_table.h"
+#include "optim/go_collocation.h"
+
+#define GO_GAIT_NGRF 6  // grf variables per node: right foot x y z, left foot x y z (world)
+
+// Options of the gait problem; go_gait_opts_default fills them.
+typedef struct {
+  int N;                            // nodes (>= 2)
+  int nthreads;                     // engine workers (>= 1)
+  double T;                         // stride time (s); <= 0: the coordinate table's time span
+  const gsTable* coords;            // measured coordinates, radians, model names (NULL: none)
+  const gsTable* grf;               // measured ground reactions, OpenSim ExternalLoads names and
+                                    // frame (Y up), same time base as coords (NULL: none)
+  double w_pelvis_rot;              // weight of pelvis rotation tracking                 (-)
+  double w_pelvis_trans;            // weight of pelvis translation tracking              (-)
+  double w_joint;                   // weight of the other coordinates                    (-)
+  double w_grf;                     // weight of ground reaction tracking                 (-)
+  double w_effort;                  // weight of the mean squared excitation              (-)
+  int periodic;                     // 1: periodicity boundary rows
+  const char* const* free_coords;   // NULL-terminated coordinates left out of periodicity
+                                    // besides pelvis_tx (NULL: none)
+  double speed;                     // > 0: mean forward speed constraint                (m/s)
+} go_gait_opts;
+
+// Where everything sits in z_k and in the path rows of a node.
+typedef struct {
+  int nv;        // degrees of freedom (nq == nv)
+  int na;        // muscles (activations, excitations)
+  int ne;        // elastic-tendon muscles
+  int nx;        // states, 2 nv + na + ne
+  int nz;        // node variables, 2 nx + na + GO_GAIT_NGRF
+  int n_path;    // path rows, 2 nv + ne + na + GO_GAIT_NGRF
+  int x_q, x_qd, x_a, x_ft;        // offsets of q, qdot, a, fT in z_k
+  int xd_q, xd_qdd, xd_a, xd_ft;   // offsets of q', qddot, adot, fT'
+  int u_e, u_grf;                  // offsets of excitations and grf variables
+  int r_link, r_eom, r_hill, r_act, r_grf;  // offsets of the path row blocks
+  const int* elastic;              // actuator of elastic muscle e (ne)
+  const int* elastic_of;           // elastic index of actuator i, -1 if rigid (na)
+  int tx;                          // dof of pelvis_tx, -1 if none
+} go_gait_layout;
+
+typedef struct go_gait go_gait;
+
+// defaults: N 40, 1 thread, T from coords, w_pelvis_rot 1, w_pelvis_trans 1, w_joint 1, w_grf 1,
+// w_effort 0.1, periodic 1, no free coordinates, no speed constraint
+void go_gait_opts_default(go_gait_opts* opts);
+
+// Build the problem for model m (prepared by gs_physics_prepare; every actuator must be a gaitsim
+// muscle with an activation state). m is copied (the copy has MuJoCo's constraint stage off);
+// coords and grf are read here and not kept. Returns 0 and *out (free with go_gait_free), or -1
+// with the reason in err.
+int go_gait_create(go_gait** out, const mjModel* m, const go_gait_opts* opts, char* err,
+                   int errsz);
+void go_gait_free(go_gait* g);
+
+// the collocation NLP (owned by g), its layout, and the private model copy
+go_nlp* go_gait_nlp(go_gait* g);
+const go_gait_layout* go_gait_layout_get(const go_gait* g);
+const mjModel* go_gait_model(const go_gait* g);
+int go_gait_nodes(const go_gait* g);
+double go_gait_stride_time(const go_gait* g);
+double go_gait_weight(const go_gait* g);   // body weight m g (N)
+
+// 1 if dof j belongs to the root body (the pelvis: the body of the tree's first dof), else 0.
+int go_gait_dof_is_root(const mjModel* m, int j);
+
+// Measured coordinate at node k, dof j (physical), or NAN when not measured.
+double go_gait_q_ref(const go_gait* g, int k, int j);
+// Measured ground reaction at node k, component c (world, N, GO_GAIT_NGRF), or NAN.
+double go_gait_grf_ref(const go_gait* g, int k, int c);
+
+// Load node variables z_k (physical) into d (qpos, qvel, qacc, act, ctrl, userdata) and run
+// mj_inverse: afterwards d holds the node's kinematics, contact and inverse dynamics (for
+// writing tables). d must come from go_gait_model(g).
+void go_gait_load_node(const go_gait* g, mjData* d, const double* z_k);
+
+// Path rows of node k at physical z_k into res (n_path), with d as scratch. 0, or -1 when a value
+// is not finite.
+int go_gait_path_eval(const go_gait* g, mjData* d, const double* z_k, double* res);
+
+#endif  // GAITSIM_OPTIM_GO_GAIT_H_

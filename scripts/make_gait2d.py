@@ -18,8 +18,9 @@ Standard library only. Deterministic output; written atomically.
 import argparse
 import os
 import sys
-import tempfile
 import xml.etree.ElementTree as ET
+
+from gs_scriptlib import write_atomic
 
 KEPT_JOINTS_COMMON = ["pelvis_tx", "pelvis_ty", "pelvis_rz"]
 KEPT_JOINTS_RIGHT = ["hip_flexion", "knee_flexion", "ankle_angle"]
@@ -124,11 +125,7 @@ def main():
         "\n  (provenance: see that file); removed joints are welded at their reference value.\n")
     ET.indent(tree, space="  ")
     body = ET.tostring(root, encoding="unicode")
-    out_dir = os.path.dirname(os.path.abspath(args.out))
-    fd, tmp = tempfile.mkstemp(prefix=".gait2d.", dir=out_dir)
-    with os.fdopen(fd, "w") as f:
-        f.write("<!--" + header + "-->\n" + body + "\n")
-    os.replace(tmp, args.out)
+    write_atomic(args.out, "<!--" + header + "-->\n" + body + "\n")
     print(f"make_gait2d: wrote {args.out}")
 
 

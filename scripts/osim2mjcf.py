@@ -20,6 +20,8 @@ import math
 import os
 import xml.etree.ElementTree as ET
 
+from gs_scriptlib import write_atomic
+
 CONVERTER = "scripts/osim2mjcf.py"
 
 # ------------------------------------------------------------------------------------------------
@@ -1315,18 +1317,7 @@ class Converter:
         out.append('    <key name="standing" qpos="%s"/>' % fvec(qpos))
         out.append("  </keyframe>")
         out.append("</mujoco>")
-        write_text(path, "\n".join(out) + "\n")
-
-
-def write_text(path, text):
-    """Write to a temporary name and rename: a crash never leaves half a file."""
-    d = os.path.dirname(path)
-    if d:
-        os.makedirs(d, exist_ok=True)
-    tmp = path + ".tmp"
-    with open(tmp, "w", newline="\n") as f:
-        f.write(text)
-    os.replace(tmp, path)
+        write_atomic(path, "\n".join(out) + "\n")
 
 
 def write_reference(model, frames, path, poses_path, osim_name, trial_name):
@@ -1366,8 +1357,8 @@ def write_reference(model, frames, path, poses_path, osim_name, trial_name):
             crossed = crossed_coordinates(model, mus)
             for c, r in moment_arms(model, mus, pose, crossed).items():
                 lines.append("%d,%s,%s,%s,%d,%d" % (k, mus["name"], c, fmt(r, 8), wraps, clear))
-    write_text(path, "\n".join(lines) + "\n")
-    write_text(poses_path, "\n".join(pose_lines) + "\n")
+    write_atomic(path, "\n".join(lines) + "\n")
+    write_atomic(poses_path, "\n".join(pose_lines) + "\n")
 
 
 def main():

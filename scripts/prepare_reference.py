@@ -21,9 +21,10 @@ import argparse
 import datetime
 import os
 import sys
-import tempfile
 
 import numpy as np
+
+from gs_scriptlib import PrepError, write_atomic
 
 SCRIPT = "scripts/prepare_reference.py"
 SOURCE = "antoinefalisse/3dpredictsim ExperimentalData/ExperimentalData.mat (MIT), subject1, Falisse et al. 2019"
@@ -57,12 +58,6 @@ Q_MAP = {
     "arm_rot": "arm_rot_r", "elbow_flex": "elbow_flex_r",
 }
 GRF_MAP = {"Fore-aft": "vx", "Vertical": "vy", "Lateral": "vz"}
-
-
-class PrepError(Exception):
-    def __init__(self, file, reason):
-        super().__init__(f"{file}: {reason}")
-        self.file, self.reason = file, reason
 
 
 def read_csv(path, required, allow_nan=False):
@@ -103,22 +98,6 @@ def read_csv(path, required, allow_nan=False):
         if not allow_nan and not np.all(np.isfinite(a)):
             raise PrepError(path, f"column {h}: NaN in {int(np.sum(~np.isfinite(a)))} row(s)")
     return comments, header, cols
-
-
-def write_atomic(path, text):
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", dir=folder)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
 
 
 def fmt(v):

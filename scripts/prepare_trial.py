@@ -35,11 +35,12 @@ import json
 import math
 import os
 import sys
-import tempfile
 
 import numpy as np
 from scipy.interpolate import CubicSpline
 from scipy.signal import butter, filtfilt
+
+from gs_scriptlib import PrepError, write_atomic
 
 LBF_TO_N = 4.4482216152605
 GRAVITY = 9.80665
@@ -71,15 +72,6 @@ KCF_COLS = ["PM", "AM", "AL", "PL", "GON", "GRFz"]
 MIN_CONTACT_S = 0.10    # shorter supra-threshold intervals are ignored
 MIN_STRIDE_S = 0.6      # a second right heel strike must be this far after the first
 MAX_STRIDE_S = 2.0
-
-
-class PrepError(Exception):
-    """A reportable input problem: file and reason."""
-
-    def __init__(self, file, reason):
-        super().__init__(f"{file}: {reason}")
-        self.file = file
-        self.reason = reason
 
 
 # ---------------------------------------------------------------------------------------------
@@ -271,23 +263,6 @@ def write_storage(path, name, columns, data, in_degrees, provenance):
     lines.append("\t".join(columns))
     body = "\n".join("\t".join(f"{v:.8g}" for v in row) for row in data)
     write_atomic(path, "\n".join(lines) + "\n" + body + "\n")
-
-
-def write_atomic(path, text):
-    """Write text to a temporary file in the same folder, then rename over path."""
-    folder = os.path.dirname(os.path.abspath(path))
-    fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", dir=folder)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
 
 
 # ---------------------------------------------------------------------------------------------

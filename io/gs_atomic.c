@@ -5,47 +5,22 @@
 
 #include <errno.h>
 #include <fcntl.h>
-#include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <sys/types.h>
 #include <unistd.h>
 
-// format one line into err; control characters become '?'
-static void set_err(char* err, int errsz, const char* fmt, ...) {
-  if (!err || errsz <= 0) {
-    return;
-  }
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(err, (size_t)errsz, fmt, ap);
-  va_end(ap);
-  for (char* p = err; *p; p++) {
-    if ((unsigned char)*p < 0x20 || *p == 0x7f) {
-      *p = '?';
-    }
-  }
-}
-
-// malloc'ed copy of s
-static char* dup_string(const char* s) {
-  size_t n = strlen(s) + 1;
-  char* c = malloc(n);
-  if (c) {
-    memcpy(c, s, n);
-  }
-  return c;
-}
+#include "io/gs_text.h"
 
 // directory part of path ("." when there is none), malloc'ed
 static char* dir_of(const char* path) {
   const char* slash = strrchr(path, '/');
   if (!slash) {
-    return dup_string(".");
+    return gs_string_dup(".");
   }
   if (slash == path) {
-    return dup_string("/");
+    return gs_string_dup("/");
   }
   size_t n = (size_t)(slash - path);
   char* d = malloc(n + 1);
@@ -70,17 +45,17 @@ int gs_atomic_open(gsAtomicFile* a, const char* path, char* err, int errsz) {
   a->path = NULL;
   a->tmppath = NULL;
   if (!path || !path[0]) {
-    set_err(err, errsz, "gs_atomic_open: empty path");
+    gs_error_set(err, errsz, "gs_atomic_open: empty path");
     return -1;
   }
 
   // the temporary name lives next to the target so rename stays within one file system
   size_t n = strlen(path);
-  a->path = dup_string(path);
+  a->path = gs_string_dup(path);
   a->tmppath = malloc(n + sizeof(".tmp.XXXXXX"));
   if (!a->path || !a->tmppath) {
     release(a);
-    set_err(err, errsz, "%s: out of memory", path);
+    gs_error_set(err, errsz, "%s: out of memory", path);
     return -1;
   }
   memcpy(a->tmppath, path, n);
@@ -88,7 +63,7 @@ int gs_atomic_open(gsAtomicFile* a, const char* path, char* err, int errsz) {
 
   int fd = mkstemp(a->tmppath);
   if (fd < 0) {
-    set_err(err, errsz, "%s: cannot create temporary file: %s", path, strerror(errno));
+    gs_error_set(err, errsz, "%s: cannot create temporary file: %s", path, strerror(errno));
     release(a);
     return -1;
   }
@@ -100,7 +75,7 @@ int gs_atomic_open(gsAtomicFile* a, const char* path, char* err, int errsz) {
     mode = st.st_mode & 07777;
   }
   if (fchmod(fd, mode) != 0) {
-    set_err(err, errsz, "%s: cannot set mode of temporary file: %s", path, strerror(errno));
+    gs_error_set(err, errsz, "%s: cannot set mode of temporary file: %s", path, strerror(errno));
     close(fd);
     unlink(a->tmppath);
     release(a);
@@ -109,7 +84,7 @@ int gs_atomic_open(gsAtomicFile* a, const char* path, char* err, int errsz) {
 
   a->f = fdopen(fd, "wb");
   if (!a->f) {
-    set_err(err, errsz, "%s: cannot open temporary file: %s", path, strerror(errno));
+    gs_error_set(err, errsz, "%s: cannot open temporary file: %s", path, strerror(errno));
     close(fd);
     unlink(a->tmppath);
     release(a);
@@ -133,7 +108,7 @@ void gs_atomic_abort(gsAtomicFile* a) {
 
 int gs_atomic_commit(gsAtomicFile* a, char* err, int errsz) {
   if (!a || !a->f || !a->path || !a->tmppath) {
-    set_err(err, errsz, "gs_atomic_commit: file is not open");
+    gs_error_set(err, errsz, "gs_atomic_commit: file is not open");
     gs_atomic_abort(a);
     return -1;
   }
@@ -156,14 +131,14 @@ int gs_atomic_commit(gsAtomicFile* a, char* err, int errsz) {
     saved = errno;
   }
   if (failed) {
-    set_err(err, errsz, "%s: write failed: %s", a->path, strerror(saved));
+    gs_error_set(err, errsz, "%s: write failed: %s", a->path, strerror(saved));
     gs_atomic_abort(a);
     return -1;
   }
 
   // publish
   if (rename(a->tmppath, a->path) != 0) {
-    set_err(err, errsz, "%s: cannot rename temporary file: %s", a->path, strerror(errno));
+    gs_error_set(err, errsz, "%s: cannot rename temporary file: %s", a->path, strerror(errno));
     gs_atomic_abort(a);
     return -1;
   }
@@ -188,7 +163,7 @@ int gs_atomic_write_buffer(const char* path, const void* bytes, size_t n, char* 
     return -1;
   }
   if (n > 0 && fwrite(bytes, 1, n, a.f) != n) {
-    set_err(err, errsz, "%s: write failed: %s", path, strerror(errno));
+    gs_error_set(err, errsz, "%s: write failed: %s", path, strerror(errno));
     gs_atomic_abort(&a);
     return -1;
   }
@@ -206,22 +181,22 @@ static int mkdir_one(const char* dir, const char* full, char* err, int errsz) {
     if (S_ISDIR(st.st_mode)) {
       return 0;
     }
-    set_err(err, errsz, "%s: cannot create directory: '%s' exists and is not a directory", full,
+    gs_error_set(err, errsz, "%s: cannot create directory: '%s' exists and is not a directory", full,
             dir);
     return -1;
   }
-  set_err(err, errsz, "%s: cannot create directory '%s': %s", full, dir, strerror(saved));
+  gs_error_set(err, errsz, "%s: cannot create directory '%s': %s", full, dir, strerror(saved));
   return -1;
 }
 
 int gs_mkdir_p(const char* path, char* err, int errsz) {
   if (!path || !path[0]) {
-    set_err(err, errsz, "gs_mkdir_p: empty path");
+    gs_error_set(err, errsz, "gs_mkdir_p: empty path");
     return -1;
   }
-  char* buf = dup_string(path);
+  char* buf = gs_string_dup(path);
   if (!buf) {
-    set_err(err, errsz, "%s: out of memory", path);
+    gs_error_set(err, errsz, "%s: out of memory", path);
     return -1;
   }
 

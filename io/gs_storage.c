@@ -8,38 +8,12 @@
 #include <float.h>
 #include <limits.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "io/gs_atomic.h"
-
-// format one line into err; control characters become '?'
-static void set_err(char* err, int errsz, const char* fmt, ...) {
-  if (!err || errsz <= 0) {
-    return;
-  }
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(err, (size_t)errsz, fmt, ap);
-  va_end(ap);
-  for (char* p = err; *p; p++) {
-    if ((unsigned char)*p < 0x20 || *p == 0x7f) {
-      *p = '?';
-    }
-  }
-}
-
-// malloc'ed copy of s
-static char* dup_string(const char* s) {
-  size_t n = strlen(s) + 1;
-  char* c = malloc(n);
-  if (c) {
-    memcpy(c, s, n);
-  }
-  return c;
-}
+#include "io/gs_text.h"
 
 // equal ignoring ASCII case
 static int ieq(const char* a, const char* b) {
@@ -98,12 +72,12 @@ static int next_line(lineReader* r, char* err, int errsz) {
     len--;
   }
   if (len > GS_STORAGE_MAX_LINE) {
-    set_err(err, errsz, "%s:%d: line longer than %d bytes", r->name, r->lineno,
+    gs_error_set(err, errsz, "%s:%d: line longer than %d bytes", r->name, r->lineno,
             GS_STORAGE_MAX_LINE);
     return -1;
   }
   if (memchr(s, '\0', len)) {
-    set_err(err, errsz, "%s:%d: NUL byte in line (binary file?)", r->name, r->lineno);
+    gs_error_set(err, errsz, "%s:%d: NUL byte in line (binary file?)", r->name, r->lineno);
     return -1;
   }
   memcpy(r->line, s, len);
@@ -265,15 +239,15 @@ static int add_label(parser* p, const char* s, int* cap, char* err, int errsz) {
     int ncap = *cap ? 2 * *cap : 16;
     char** nl = realloc(p->labels, (size_t)ncap * sizeof(char*));
     if (!nl) {
-      set_err(err, errsz, "%s:%d: out of memory", p->r.name, p->r.lineno);
+      gs_error_set(err, errsz, "%s:%d: out of memory", p->r.name, p->r.lineno);
       return -1;
     }
     p->labels = nl;
     *cap = ncap;
   }
-  p->labels[p->nlabels] = dup_string(s);
+  p->labels[p->nlabels] = gs_string_dup(s);
   if (!p->labels[p->nlabels]) {
-    set_err(err, errsz, "%s:%d: out of memory", p->r.name, p->r.lineno);
+    gs_error_set(err, errsz, "%s:%d: out of memory", p->r.name, p->r.lineno);
     return -1;
   }
   p->nlabels++;
@@ -334,11 +308,11 @@ static int read_labels(parser* p, char sep, int strip_quotes, char* err, int err
       s = trim(s + 1);
     }
     if (*s == '\0') {
-      set_err(err, errsz, "%s:%d: empty column label (column %d)", name, line, p->nlabels + 1);
+      gs_error_set(err, errsz, "%s:%d: empty column label (column %d)", name, line, p->nlabels + 1);
       return -1;
     }
     if (p->nlabels >= GS_STORAGE_MAX_CELLS) {
-      set_err(err, errsz, "%s:%d: more than %d columns", name, line, GS_STORAGE_MAX_CELLS);
+      gs_error_set(err, errsz, "%s:%d: more than %d columns", name, line, GS_STORAGE_MAX_CELLS);
       return -1;
     }
     if (add_label(p, s, &cap, err, errsz) != 0) {
@@ -348,17 +322,17 @@ static int read_labels(parser* p, char sep, int strip_quotes, char* err, int err
 
   // time first, then at least one data column, none of them called time
   if (p->nlabels == 0 || !is_time_label(p->labels[0])) {
-    set_err(err, errsz, "%s:%d: first column is '%.64s', expected 'time'", name, line,
+    gs_error_set(err, errsz, "%s:%d: first column is '%.64s', expected 'time'", name, line,
             p->nlabels ? p->labels[0] : "");
     return -1;
   }
   if (p->nlabels < 2) {
-    set_err(err, errsz, "%s:%d: no data columns besides time", name, line);
+    gs_error_set(err, errsz, "%s:%d: no data columns besides time", name, line);
     return -1;
   }
   for (int k = 1; k < p->nlabels; k++) {
     if (is_time_label(p->labels[k])) {
-      set_err(err, errsz, "%s:%d: column %d '%.64s' duplicates the time column", name, line,
+      gs_error_set(err, errsz, "%s:%d: column %d '%.64s' duplicates the time column", name, line,
               k + 1, p->labels[k]);
       return -1;
     }
@@ -370,11 +344,11 @@ static int read_labels(parser* p, char sep, int strip_quotes, char* err, int err
   int dup = p->cells ? find_duplicate((const char* const*)p->labels + 1, p->nlabels - 1, &c1, &c2)
                      : -1;
   if (dup < 0) {
-    set_err(err, errsz, "%s:%d: out of memory", name, line);
+    gs_error_set(err, errsz, "%s:%d: out of memory", name, line);
     return -1;
   }
   if (dup) {
-    set_err(err, errsz, "%s:%d: duplicate column '%.64s' (columns %d and %d)", name, line,
+    gs_error_set(err, errsz, "%s:%d: duplicate column '%.64s' (columns %d and %d)", name, line,
             p->labels[c2 + 1], c1 + 2, c2 + 2);
     return -1;
   }
@@ -397,7 +371,7 @@ static int read_row(parser* p, char sep, char* err, int errsz) {
     n++;
   }
   if (n != p->nlabels) {
-    set_err(err, errsz, "%s:%d: %d cells, expected %d (too %s)%s", name, line, n, p->nlabels,
+    gs_error_set(err, errsz, "%s:%d: %d cells, expected %d (too %s)%s", name, line, n, p->nlabels,
             n < p->nlabels ? "few" : "many", trunc);
     return -1;
   }
@@ -405,7 +379,7 @@ static int read_row(parser* p, char sep, char* err, int errsz) {
   // room for one more row, within the cell limit
   int ncol = p->nlabels - 1;
   if ((size_t)(p->nrow + 1) * (size_t)p->nlabels > GS_STORAGE_MAX_CELLS) {
-    set_err(err, errsz, "%s:%d: more than %d cells", name, line, GS_STORAGE_MAX_CELLS);
+    gs_error_set(err, errsz, "%s:%d: more than %d cells", name, line, GS_STORAGE_MAX_CELLS);
     return -1;
   }
   if (p->nrow == p->cap) {
@@ -416,7 +390,7 @@ static int read_row(parser* p, char sep, char* err, int errsz) {
     }
     double* nd = nt ? realloc(p->data, (size_t)ncap * (size_t)ncol * sizeof(double)) : NULL;
     if (!nd) {
-      set_err(err, errsz, "%s:%d: out of memory", name, line);
+      gs_error_set(err, errsz, "%s:%d: out of memory", name, line);
       return -1;
     }
     p->data = nd;
@@ -429,7 +403,7 @@ static int read_row(parser* p, char sep, char* err, int errsz) {
     double v = 0.0;
     int rc = parse_number(p->cells[k], &v);
     if (rc != 0) {
-      set_err(err, errsz, "%s:%d: column %d '%.64s': '%.32s' is %s%s", name, line, k + 1,
+      gs_error_set(err, errsz, "%s:%d: column %d '%.64s': '%.32s' is %s%s", name, line, k + 1,
               p->labels[k], p->cells[k],
               rc == -1 ? (p->cells[k][0] ? "not a number" : "empty")
                        : "not finite (NaN, Inf or overflow)",
@@ -445,7 +419,7 @@ static int read_row(parser* p, char sep, char* err, int errsz) {
 
   // time strictly increasing
   if (p->nrow > 0 && !(p->time[p->nrow] > p->time[p->nrow - 1])) {
-    set_err(err, errsz, "%s:%d: time %.10g is not greater than the previous time %.10g", name,
+    gs_error_set(err, errsz, "%s:%d: time %.10g is not greater than the previous time %.10g", name,
             line, p->time[p->nrow], p->time[p->nrow - 1]);
     return -1;
   }
@@ -468,8 +442,8 @@ static int parse_storage(parser* p, char* err, int errsz) {
     }
     char* eq = strchr(s, '=');
     if (r->lineno == 1 && !eq) {
-      if (*s && !(p->name = dup_string(s))) {
-        set_err(err, errsz, "%s:1: out of memory", r->name);
+      if (*s && !(p->name = gs_string_dup(s))) {
+        gs_error_set(err, errsz, "%s:1: out of memory", r->name);
         return -1;
       }
       continue;
@@ -493,7 +467,7 @@ static int parse_storage(parser* p, char* err, int errsz) {
     if (ieq(key, "nRows") || ieq(key, "nColumns")) {
       int v = 0;
       if (parse_count(val, &v) != 0 || v > GS_STORAGE_MAX_CELLS) {
-        set_err(err, errsz, "%s:%d: %s '%.32s' is not a count in [0, %d]", r->name, r->lineno,
+        gs_error_set(err, errsz, "%s:%d: %s '%.32s' is not a count in [0, %d]", r->name, r->lineno,
                 key, val, GS_STORAGE_MAX_CELLS);
         return -1;
       }
@@ -510,13 +484,13 @@ static int parse_storage(parser* p, char* err, int errsz) {
       } else if (ieq(val, "no")) {
         p->in_degrees = 0;
       } else {
-        set_err(err, errsz, "%s:%d: inDegrees must be yes or no, got '%.32s'", r->name,
+        gs_error_set(err, errsz, "%s:%d: inDegrees must be yes or no, got '%.32s'", r->name,
                 r->lineno, val);
         return -1;
       }
     } else if (ieq(key, "DataType")) {
       if (!ieq(val, "double")) {
-        set_err(err, errsz, "%s:%d: DataType=%.32s not supported (only double)", r->name,
+        gs_error_set(err, errsz, "%s:%d: DataType=%.32s not supported (only double)", r->name,
                 r->lineno, val);
         return -1;
       }
@@ -526,14 +500,14 @@ static int parse_storage(parser* p, char* err, int errsz) {
     return -1;
   }
   if (!have_end) {
-    set_err(err, errsz, "%s:%d: missing endheader (end of file reached in the header)", r->name,
+    gs_error_set(err, errsz, "%s:%d: missing endheader (end of file reached in the header)", r->name,
             r->lineno);
     return -1;
   }
   int end_line = r->lineno;
   if (nrows_decl >= 0 && ncols_decl >= 0 &&
       (size_t)nrows_decl * (size_t)ncols_decl > GS_STORAGE_MAX_CELLS) {
-    set_err(err, errsz, "%s:%d: nRows x nColumns = %d x %d exceeds %d cells", r->name,
+    gs_error_set(err, errsz, "%s:%d: nRows x nColumns = %d x %d exceeds %d cells", r->name,
             nrows_line, nrows_decl, ncols_decl, GS_STORAGE_MAX_CELLS);
     return -1;
   }
@@ -545,7 +519,7 @@ static int parse_storage(parser* p, char* err, int errsz) {
     return -1;
   }
   if (rc == 0) {
-    set_err(err, errsz, "%s:%d: no column labels after endheader (line %d)", r->name,
+    gs_error_set(err, errsz, "%s:%d: no column labels after endheader (line %d)", r->name,
             r->lineno, end_line);
     return -1;
   }
@@ -553,7 +527,7 @@ static int parse_storage(parser* p, char* err, int errsz) {
     return -1;
   }
   if (ncols_decl >= 0 && ncols_decl != p->nlabels) {
-    set_err(err, errsz, "%s:%d: %d column labels but nColumns=%d (line %d)", r->name, r->lineno,
+    gs_error_set(err, errsz, "%s:%d: %d column labels but nColumns=%d (line %d)", r->name, r->lineno,
             p->nlabels, ncols_decl, ncols_line);
     return -1;
   }
@@ -568,11 +542,11 @@ static int parse_storage(parser* p, char* err, int errsz) {
     return -1;
   }
   if (p->nrow == 0) {
-    set_err(err, errsz, "%s:%d: no data rows (header only)", r->name, r->lineno);
+    gs_error_set(err, errsz, "%s:%d: no data rows (header only)", r->name, r->lineno);
     return -1;
   }
   if (nrows_decl >= 0 && nrows_decl != p->nrow) {
-    set_err(err, errsz, "%s:%d: nRows=%d but the file has %d data rows", r->name, nrows_line,
+    gs_error_set(err, errsz, "%s:%d: nRows=%d but the file has %d data rows", r->name, nrows_line,
             nrows_decl, p->nrow);
     return -1;
   }
@@ -599,7 +573,7 @@ static int parse_csv(parser* p, char* err, int errsz) {
     return -1;
   }
   if (rc == 0) {
-    set_err(err, errsz, "%s:%d: no header line (only comments)", r->name, r->lineno);
+    gs_error_set(err, errsz, "%s:%d: no header line (only comments)", r->name, r->lineno);
     return -1;
   }
   if (read_labels(p, ',', 1, err, errsz) != 0) {
@@ -616,7 +590,7 @@ static int parse_csv(parser* p, char* err, int errsz) {
     return -1;
   }
   if (p->nrow == 0) {
-    set_err(err, errsz, "%s:%d: no data rows (header only)", r->name, r->lineno);
+    gs_error_set(err, errsz, "%s:%d: no data rows (header only)", r->name, r->lineno);
     return -1;
   }
   return 0;
@@ -669,7 +643,7 @@ int gs_storage_read_buffer(const char* bytes, size_t n, const char* name_for_err
                            char* err, int errsz) {
   const char* name = name_for_errors ? name_for_errors : "buffer";
   if (n > (size_t)GS_STORAGE_MAX_BYTES) {
-    set_err(err, errsz, "%s: larger than %ld bytes", name, (long)GS_STORAGE_MAX_BYTES);
+    gs_error_set(err, errsz, "%s: larger than %ld bytes", name, (long)GS_STORAGE_MAX_BYTES);
     return -1;
   }
 
@@ -679,7 +653,7 @@ int gs_storage_read_buffer(const char* bytes, size_t n, const char* name_for_err
     k++;
   }
   if (k == n) {
-    set_err(err, errsz, "%s:1: empty file", name);
+    gs_error_set(err, errsz, "%s:1: empty file", name);
     return -1;
   }
 
@@ -690,7 +664,7 @@ int gs_storage_read_buffer(const char* bytes, size_t n, const char* name_for_err
   p.r.name = name;
   p.r.line = malloc((n < GS_STORAGE_MAX_LINE ? n : GS_STORAGE_MAX_LINE) + 1);
   if (!p.r.line) {
-    set_err(err, errsz, "%s: out of memory", name);
+    gs_error_set(err, errsz, "%s: out of memory", name);
     return -1;
   }
   int rc = looks_like_csv(bytes, n, name) ? parse_csv(&p, err, errsz)
@@ -709,7 +683,7 @@ int gs_storage_read_buffer(const char* bytes, size_t n, const char* name_for_err
   tmp.data = p.data;
   tmp.labels = malloc((size_t)tmp.ncol * sizeof(char*));
   if (!tmp.labels) {
-    set_err(err, errsz, "%s: out of memory", name);
+    gs_error_set(err, errsz, "%s: out of memory", name);
     parser_free(&p);
     return -1;
   }
@@ -728,7 +702,7 @@ int gs_storage_read_buffer(const char* bytes, size_t n, const char* name_for_err
 int gs_storage_read(const char* path, gsTable* t, char* err, int errsz) {
   FILE* f = fopen(path, "rb");
   if (!f) {
-    set_err(err, errsz, "%s: cannot open: %s", path, strerror(errno));
+    gs_error_set(err, errsz, "%s: cannot open: %s", path, strerror(errno));
     return -1;
   }
 
@@ -743,7 +717,7 @@ int gs_storage_read(const char* path, gsTable* t, char* err, int errsz) {
     if (cap > (size_t)GS_STORAGE_MAX_BYTES) {
       free(buf);
       fclose(f);
-      set_err(err, errsz, "%s: larger than %ld bytes", path, (long)GS_STORAGE_MAX_BYTES);
+      gs_error_set(err, errsz, "%s: larger than %ld bytes", path, (long)GS_STORAGE_MAX_BYTES);
       return -1;
     }
     char* nb = realloc(buf, 2 * cap);
@@ -755,14 +729,14 @@ int gs_storage_read(const char* path, gsTable* t, char* err, int errsz) {
   }
   if (!buf) {
     fclose(f);
-    set_err(err, errsz, "%s: out of memory", path);
+    gs_error_set(err, errsz, "%s: out of memory", path);
     return -1;
   }
   if (ferror(f)) {
     int saved = errno;
     free(buf);
     fclose(f);
-    set_err(err, errsz, "%s: read failed: %s", path, strerror(saved));
+    gs_error_set(err, errsz, "%s: read failed: %s", path, strerror(saved));
     return -1;
   }
   fclose(f);
@@ -823,15 +797,15 @@ static int valid_name(const char* s) {
 static int validate(const gsTable* t, const char* name, const char* const* extra, int nextra,
                     char* err, int errsz) {
   if (t->nrow < 1 || t->ncol < 1 || !t->time || !t->data || !t->labels) {
-    set_err(err, errsz, "%s: table is empty (%d rows, %d columns)", name, t->nrow, t->ncol);
+    gs_error_set(err, errsz, "%s: table is empty (%d rows, %d columns)", name, t->nrow, t->ncol);
     return -1;
   }
   if ((size_t)t->nrow * ((size_t)t->ncol + 1) > GS_STORAGE_MAX_CELLS) {
-    set_err(err, errsz, "%s: table has more than %d cells", name, GS_STORAGE_MAX_CELLS);
+    gs_error_set(err, errsz, "%s: table has more than %d cells", name, GS_STORAGE_MAX_CELLS);
     return -1;
   }
   if (t->name && !valid_name(t->name)) {
-    set_err(err, errsz, "%s: table name '%.64s' cannot be a header line", name, t->name);
+    gs_error_set(err, errsz, "%s: table name '%.64s' cannot be a header line", name, t->name);
     return -1;
   }
 
@@ -839,7 +813,7 @@ static int validate(const gsTable* t, const char* name, const char* const* extra
   for (int j = 0; j < t->ncol; j++) {
     const char* s = t->labels[j];
     if (!s || !*s || strchr(s, ' ') || has_control(s) || is_time_label(s)) {
-      set_err(err, errsz, "%s: column %d label '%.64s' is empty, has whitespace or is time",
+      gs_error_set(err, errsz, "%s: column %d label '%.64s' is empty, has whitespace or is time",
               name, j + 1, s ? s : "(null)");
       return -1;
     }
@@ -847,11 +821,11 @@ static int validate(const gsTable* t, const char* name, const char* const* extra
   int c1 = 0, c2 = 0;
   int dup = find_duplicate((const char* const*)t->labels, t->ncol, &c1, &c2);
   if (dup < 0) {
-    set_err(err, errsz, "%s: out of memory", name);
+    gs_error_set(err, errsz, "%s: out of memory", name);
     return -1;
   }
   if (dup) {
-    set_err(err, errsz, "%s: duplicate column '%.64s' (columns %d and %d)", name, t->labels[c2],
+    gs_error_set(err, errsz, "%s: duplicate column '%.64s' (columns %d and %d)", name, t->labels[c2],
             c1 + 1, c2 + 1);
     return -1;
   }
@@ -859,13 +833,13 @@ static int validate(const gsTable* t, const char* name, const char* const* extra
   // values finite, time strictly increasing
   for (int i = 0; i < t->nrow; i++) {
     if (!isfinite(t->time[i]) || (i > 0 && !(t->time[i] > t->time[i - 1]))) {
-      set_err(err, errsz, "%s: time %.10g at row %d is not finite or not increasing", name,
+      gs_error_set(err, errsz, "%s: time %.10g at row %d is not finite or not increasing", name,
               t->time[i], i + 1);
       return -1;
     }
     for (int j = 0; j < t->ncol; j++) {
       if (!isfinite(t->data[(size_t)i * t->ncol + j])) {
-        set_err(err, errsz, "%s: column '%.64s' is NaN or Inf at row %d (time %.10g)", name,
+        gs_error_set(err, errsz, "%s: column '%.64s' is NaN or Inf at row %d (time %.10g)", name,
                 t->labels[j], i + 1, t->time[i]);
         return -1;
       }
@@ -885,7 +859,7 @@ static int validate(const gsTable* t, const char* name, const char* const* extra
     }
     if (!s || strchr(s, '\n') || strchr(s, '\r') || strncmp(trim(buf), "endheader", 10) == 0 ||
         is_reserved_header(s)) {
-      set_err(err, errsz, "%s: extra header line %d '%.64s' is not allowed", name, k + 1,
+      gs_error_set(err, errsz, "%s: extra header line %d '%.64s' is not allowed", name, k + 1,
               s ? s : "(null)");
       return -1;
     }
@@ -952,7 +926,7 @@ int gs_storage_write_stream(FILE* f, const char* name_for_errors, const gsTable*
   default_name(name_for_errors, title, sizeof(title));
   write_body(f, t->name ? t->name : title, t, extra_header, nextra);
   if (fflush(f) != 0 || ferror(f)) {
-    set_err(err, errsz, "%s: write failed: %s", name, strerror(errno));
+    gs_error_set(err, errsz, "%s: write failed: %s", name, strerror(errno));
     return -1;
   }
   return 0;

@@ -3,39 +3,14 @@
 
 #include <ctype.h>
 #include <math.h>
-#include <stdarg.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "io/gs_text.h"
+
 #define GS_TABLE_PI 3.14159265358979323846
-
-// format one line into err; control characters become '?'
-static void set_err(char* err, int errsz, const char* fmt, ...) {
-  if (!err || errsz <= 0) {
-    return;
-  }
-  va_list ap;
-  va_start(ap, fmt);
-  vsnprintf(err, (size_t)errsz, fmt, ap);
-  va_end(ap);
-  for (char* p = err; *p; p++) {
-    if ((unsigned char)*p < 0x20 || *p == 0x7f) {
-      *p = '?';
-    }
-  }
-}
-
-// malloc'ed copy of s
-static char* dup_string(const char* s) {
-  size_t n = strlen(s) + 1;
-  char* c = malloc(n);
-  if (c) {
-    memcpy(c, s, n);
-  }
-  return c;
-}
 
 void gs_table_init(gsTable* t) {
   memset(t, 0, sizeof(*t));
@@ -61,16 +36,16 @@ void gs_table_free(gsTable* t) {
 static int alloc_table(gsTable* t, int nrow, int ncol, const char* fn, char* err, int errsz) {
   gs_table_init(t);
   if (nrow < 0 || ncol < 0) {
-    set_err(err, errsz, "%s: negative size %d x %d", fn, nrow, ncol);
+    gs_error_set(err, errsz, "%s: negative size %d x %d", fn, nrow, ncol);
     return -1;
   }
   size_t cells = (size_t)nrow * (size_t)ncol;
   if (ncol > 0 && cells / (size_t)ncol != (size_t)nrow) {
-    set_err(err, errsz, "%s: size %d x %d overflows", fn, nrow, ncol);
+    gs_error_set(err, errsz, "%s: size %d x %d overflows", fn, nrow, ncol);
     return -1;
   }
   if (cells > SIZE_MAX / sizeof(double)) {
-    set_err(err, errsz, "%s: size %d x %d too large", fn, nrow, ncol);
+    gs_error_set(err, errsz, "%s: size %d x %d too large", fn, nrow, ncol);
     return -1;
   }
   t->nrow = nrow;
@@ -80,7 +55,7 @@ static int alloc_table(gsTable* t, int nrow, int ncol, const char* fn, char* err
   t->labels = calloc(ncol > 0 ? (size_t)ncol : 1, sizeof(char*));
   if (!t->time || !t->data || !t->labels) {
     gs_table_free(t);
-    set_err(err, errsz, "%s: out of memory for %d x %d table", fn, nrow, ncol);
+    gs_error_set(err, errsz, "%s: out of memory for %d x %d table", fn, nrow, ncol);
     return -1;
   }
   return 0;
@@ -106,10 +81,10 @@ int gs_table_create(gsTable* t, int nrow, int ncol, const char* const* labels, c
       snprintf(buf, sizeof(buf), "c%d", j + 1);
       s = buf;
     }
-    tmp.labels[j] = dup_string(s);
+    tmp.labels[j] = gs_string_dup(s);
     if (!tmp.labels[j]) {
       gs_table_free(&tmp);
-      set_err(err, errsz, "gs_table_create: out of memory");
+      gs_error_set(err, errsz, "gs_table_create: out of memory");
       return -1;
     }
   }
@@ -142,9 +117,9 @@ int gs_table_copy(const gsTable* src, gsTable* dst, char* err, int errsz) {
 int gs_table_set_name(gsTable* t, const char* name, char* err, int errsz) {
   char* copy = NULL;
   if (name) {
-    copy = dup_string(name);
+    copy = gs_string_dup(name);
     if (!copy) {
-      set_err(err, errsz, "gs_table_set_name: out of memory");
+      gs_error_set(err, errsz, "gs_table_set_name: out of memory");
       return -1;
     }
   }
@@ -168,27 +143,27 @@ int gs_table_column(const gsTable* t, const char* label) {
 int gs_table_select(const gsTable* src, const char* const* labels, int n, gsTable* dst, char* err,
                     int errsz) {
   if (n < 1 || !labels) {
-    set_err(err, errsz, "gs_table_select: no columns requested");
+    gs_error_set(err, errsz, "gs_table_select: no columns requested");
     return -1;
   }
 
   // map requested names to source columns
   int* idx = malloc((size_t)n * sizeof(int));
   if (!idx) {
-    set_err(err, errsz, "gs_table_select: out of memory");
+    gs_error_set(err, errsz, "gs_table_select: out of memory");
     return -1;
   }
   for (int k = 0; k < n; k++) {
     idx[k] = labels[k] ? gs_table_column(src, labels[k]) : -1;
     if (idx[k] < 0) {
-      set_err(err, errsz, "gs_table_select: column '%.64s' not found in table '%.64s'",
+      gs_error_set(err, errsz, "gs_table_select: column '%.64s' not found in table '%.64s'",
               labels[k] ? labels[k] : "(null)", src->name ? src->name : "");
       free(idx);
       return -1;
     }
     for (int m = 0; m < k; m++) {
       if (idx[m] == idx[k]) {
-        set_err(err, errsz, "gs_table_select: column '%.64s' requested twice", labels[k]);
+        gs_error_set(err, errsz, "gs_table_select: column '%.64s' requested twice", labels[k]);
         free(idx);
         return -1;
       }
@@ -219,24 +194,24 @@ int gs_table_select(const gsTable* src, const char* const* labels, int n, gsTabl
 int gs_table_resample(const gsTable* src, const double* times, int n, gsTable* dst, char* err,
                       int errsz) {
   if (n < 1 || !times) {
-    set_err(err, errsz, "gs_table_resample: no times requested");
+    gs_error_set(err, errsz, "gs_table_resample: no times requested");
     return -1;
   }
   if (src->nrow < 1) {
-    set_err(err, errsz, "gs_table_resample: source table has no rows");
+    gs_error_set(err, errsz, "gs_table_resample: source table has no rows");
     return -1;
   }
 
   // the source time must be a strictly increasing grid
   for (int i = 0; i < src->nrow; i++) {
     if (!isfinite(src->time[i]) || (i > 0 && !(src->time[i] > src->time[i - 1]))) {
-      set_err(err, errsz, "gs_table_resample: source time not strictly increasing at row %d", i);
+      gs_error_set(err, errsz, "gs_table_resample: source time not strictly increasing at row %d", i);
       return -1;
     }
   }
   double lo = src->time[0], hi = src->time[src->nrow - 1];
   if (!isfinite(hi - lo)) {
-    set_err(err, errsz, "gs_table_resample: time span [%.10g, %.10g] too large", lo, hi);
+    gs_error_set(err, errsz, "gs_table_resample: time span [%.10g, %.10g] too large", lo, hi);
     return -1;
   }
   double tol = 1e-9 * (hi - lo) + 1e-12;
@@ -244,11 +219,11 @@ int gs_table_resample(const gsTable* src, const double* times, int n, gsTable* d
   // the requested times: finite, strictly increasing, within the range
   for (int k = 0; k < n; k++) {
     if (!isfinite(times[k]) || (k > 0 && !(times[k] > times[k - 1]))) {
-      set_err(err, errsz, "gs_table_resample: requested times not strictly increasing at %d", k);
+      gs_error_set(err, errsz, "gs_table_resample: requested times not strictly increasing at %d", k);
       return -1;
     }
     if (times[k] < lo - tol || times[k] > hi + tol) {
-      set_err(err, errsz, "gs_table_resample: time %.10g outside the table's range [%.10g, %.10g]",
+      gs_error_set(err, errsz, "gs_table_resample: time %.10g outside the table's range [%.10g, %.10g]",
               times[k], lo, hi);
       return -1;
     }
@@ -293,11 +268,11 @@ int gs_table_resample(const gsTable* src, const double* times, int n, gsTable* d
 int gs_table_cut(const gsTable* src, double t0, double t1, int shift_to_zero, gsTable* dst,
                  char* err, int errsz) {
   if (!isfinite(t0) || !isfinite(t1) || !(t0 < t1)) {
-    set_err(err, errsz, "gs_table_cut: need t0 < t1, got %.10g, %.10g", t0, t1);
+    gs_error_set(err, errsz, "gs_table_cut: need t0 < t1, got %.10g, %.10g", t0, t1);
     return -1;
   }
   if (src->nrow < 2) {
-    set_err(err, errsz, "gs_table_cut: source table has %d rows, need at least 2", src->nrow);
+    gs_error_set(err, errsz, "gs_table_cut: source table has %d rows, need at least 2", src->nrow);
     return -1;
   }
 
@@ -305,7 +280,7 @@ int gs_table_cut(const gsTable* src, double t0, double t1, int shift_to_zero, gs
   double eps = 1e-9 * (t1 - t0);
   double* times = malloc(((size_t)src->nrow + 2) * sizeof(double));
   if (!times) {
-    set_err(err, errsz, "gs_table_cut: out of memory");
+    gs_error_set(err, errsz, "gs_table_cut: out of memory");
     return -1;
   }
   int n = 0;
@@ -325,7 +300,7 @@ int gs_table_cut(const gsTable* src, double t0, double t1, int shift_to_zero, gs
     if (err && errsz > 0 && strncmp(err, "gs_table_resample", 17) == 0) {
       char inner[256];
       snprintf(inner, sizeof(inner), "%s", err + 17);
-      set_err(err, errsz, "gs_table_cut%s", inner);
+      gs_error_set(err, errsz, "gs_table_cut%s", inner);
     }
     return -1;
   }

@@ -14,7 +14,8 @@ if(GAITSIM_FUZZ)
     ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/fuzz_storage.c
     ${PROJECT_SOURCE_DIR}/io/gs_storage.c
     ${PROJECT_SOURCE_DIR}/io/gs_table.c
-    ${PROJECT_SOURCE_DIR}/io/gs_atomic.c)
+    ${PROJECT_SOURCE_DIR}/io/gs_atomic.c
+    ${PROJECT_SOURCE_DIR}/io/gs_text.c)
   target_include_directories(fuzz_storage PRIVATE ${PROJECT_SOURCE_DIR})
   target_compile_options(fuzz_storage PRIVATE ${GS_FUZZ_FLAGS})
   target_link_options(fuzz_storage PRIVATE ${GS_FUZZ_FLAGS})

@@ -13,6 +13,7 @@
 #include "optim/go_collocation.h"
 #include "optim/go_jacobian.h"
 #include "tests/gs_test.h"
+#include "tests/gs_test_nlp.h"
 
 #define NN 6
 #define NX 4
@@ -202,22 +203,7 @@ int main(void) {
   // dense central differences of the whole constraint vector and objective (independent code)
   double* D = calloc((size_t)m * (size_t)n, sizeof(double));
   double* Dg = malloc(sizeof(double) * (size_t)n);
-  double* gp = malloc(sizeof(double) * (size_t)m);
-  double* gm = malloc(sizeof(double) * (size_t)m);
-  for (int v = 0; v < n; v++) {
-    double x0 = zs[v], h = 6.0554544523933395e-06 * fmax(1.0, fabs(x0)), fp, fm;
-    zs[v] = x0 + h;
-    double xp = zs[v];
-    go_nlp_eval_g(a, zs, gp);
-    go_nlp_eval_f(a, zs, &fp);
-    zs[v] = x0 - h;
-    double xm = zs[v];
-    go_nlp_eval_g(a, zs, gm);
-    go_nlp_eval_f(a, zs, &fm);
-    zs[v] = x0;
-    for (int r = 0; r < m; r++) D[(size_t)r * n + v] = (gp[r] - gm[r]) / (xp - xm);
-    Dg[v] = (fp - fm) / (xp - xm);
-  }
+  gs_test_dense_fd(a, zs, m, n, D, Dg);
 
   // every engine entry matches; every dense nonzero lies in the pattern
   unsigned char* inpat = calloc((size_t)m * (size_t)n, 1);
@@ -325,6 +311,6 @@ int main(void) {
   go_nlp_free(c);
   go_nlp_free(d);
   free(z), free(zs), free(ir), free(jc), free(pairs), free(g), free(J), free(grad), free(D);
-  free(Dg), free(gp), free(gm), free(inpat), free(Jc), free(J2), free(g2), free(grad2), free(J3);
+  free(Dg), free(inpat), free(Jc), free(J2), free(g2), free(grad2), free(J3);
   return GS_TEST_RESULT();
 }

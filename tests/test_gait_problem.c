@@ -13,6 +13,7 @@
 #include "optim/go_gait_guess.h"
 #include "optim/go_jacobian.h"
 #include "tests/gs_test.h"
+#include "tests/gs_test_nlp.h"
 
 #define TRIAL GAITSIM_SOURCE_DIR "/mjmodels/trials/jw_ngait_og5"
 
@@ -123,22 +124,7 @@ int main(void) {
   // dense central differences of g and f over every variable (independent of the engine's FD)
   double* D = calloc((size_t)mm * (size_t)n, sizeof(double));
   double* Dg = malloc(sizeof(double) * (size_t)n);
-  double* gp = malloc(sizeof(double) * (size_t)mm);
-  double* gm = malloc(sizeof(double) * (size_t)mm);
-  for (int v = 0; v < n; v++) {
-    double x0 = zs[v], h = 6.0554544523933395e-06 * fmax(1.0, fabs(x0)), fp, fm;
-    zs[v] = x0 + h;
-    double xp = zs[v];
-    go_nlp_eval_g(a, zs, gp);
-    go_nlp_eval_f(a, zs, &fp);
-    zs[v] = x0 - h;
-    double xm = zs[v];
-    go_nlp_eval_g(a, zs, gm);
-    go_nlp_eval_f(a, zs, &fm);
-    zs[v] = x0;
-    for (int r = 0; r < mm; r++) D[(size_t)r * n + v] = (gp[r] - gm[r]) / (xp - xm);
-    Dg[v] = (fp - fm) / (xp - xm);
-  }
+  gs_test_dense_fd(a, zs, mm, n, D, Dg);
   unsigned char* inpat = calloc((size_t)mm * (size_t)n, 1);
   int bad_val = 0, bad_out = 0;
   double worst = 0;
@@ -205,6 +191,6 @@ int main(void) {
   gs_table_free(&grf);
   mj_deleteModel(m);
   free(z), free(zs), free(g), free(ir), free(jc), free(J), free(grad), free(D), free(Dg);
-  free(gp), free(gm), free(inpat), free(J2), free(gv2), free(grad2);
+  free(inpat), free(J2), free(gv2), free(grad2);
   return GS_TEST_RESULT();
 }

@@ -8,14 +8,7 @@
 set -u
 gaitsim=$(cd "$(dirname "$1")" && pwd)/$(basename "$1") src=$(cd "$2" && pwd)
 model=$src/mjmodels/jw_fullbody.xml
-fail=0 pass=0
-check() {
-  local name=$1; shift
-  if "$@"; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAILED: $name" >&2; fi
-}
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-cd "$work"
+source "$(dirname "$0")/../cli_common.bash"
 
 "$gaitsim" simulate "$model" --hold --drop 0.02 --duration 1 --rate 100 --out run >/dev/null
 check "simulate exits 0" test $? -eq 0
@@ -57,5 +50,4 @@ check "states finite" test "$bad" -eq 0
 check "states has the pelvis speeds" test "$n" -eq 21
 check "pelvis at rest (< 0.01)" awk -v v="$vmax" 'BEGIN { exit !(v < 0.01) }'
 
-echo "$pass passed, $fail failed"
-test "$fail" -eq 0
+finish

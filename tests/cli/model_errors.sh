@@ -4,14 +4,7 @@
 # usage: model_errors.sh GAITSIM SOURCE_DIR
 set -u
 gaitsim=$1
-fail=0 pass=0
-check() {  # check NAME CONDITION...
-  local name=$1; shift
-  if "$@"; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAILED: $name" >&2; fi
-}
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-cd "$work"
+source "$(dirname "$0")/../cli_common.bash"
 
 out=$("$gaitsim" --version)
 check "version names gaitsim" grep -q '^gaitsim [0-9]' <<<"$out"
@@ -45,5 +38,4 @@ for model in zero_size.xml truncated.xml zero_axis.xml garbage.xml missing.xml; 
 done
 check "no MUJOCO_LOG.TXT" test ! -e MUJOCO_LOG.TXT
 
-echo "$pass passed, $fail failed"
-test "$fail" -eq 0
+finish

@@ -5,14 +5,7 @@
 set -u
 gaitsim=$1 src=$2
 bench=$src/tests/fixtures/one_muscle.xml
-fail=0 pass=0
-check() {
-  local name=$1; shift
-  if "$@"; then pass=$((pass + 1)); else fail=$((fail + 1)); echo "FAILED: $name" >&2; fi
-}
-work=$(mktemp -d)
-trap 'rm -rf "$work"' EXIT
-cd "$work"
+source "$(dirname "$0")/../cli_common.bash"
 
 "$gaitsim" simulate "$bench" --excitation 1 --duration 0.2 --rate 50 --out run >/dev/null
 check "simulate exits 0" test $? -eq 0
@@ -41,5 +34,4 @@ check "earlier states.sto intact" cmp -s before.sto run/states.sto
 "$gaitsim" simulate "$bench" --duration -1 --out run 2>/dev/null
 check "negative duration is a usage error" test $? -eq 2
 
-echo "$pass passed, $fail failed"
-test "$fail" -eq 0
+finish

@@ -83,15 +83,7 @@ int gs_cmd_inspect(int argc, char** argv) {
     for (int i = m->nu - m->na; i < m->nu; i++) d->ctrl[i] = d->act[i - (m->nu - m->na)];
   }
   mj_forward(m, d);
-  for (int i = 0; i < m->nu; i++) {  // tendon forces not given: static equilibrium
-    gsMuscleParams prm;
-    if (map.fT_col[i] >= 0 || !gs_actuator_has_elastic_tendon(m, i) ||
-        gs_muscle_params_from_user(m->actuator_user + i * m->nuser_actuator, &prm, NULL, 0) != 0) {
-      continue;
-    }
-    gs_muscle_equilibrium_fT(&prm, d->act[i - (m->nu - m->na)], d->actuator_length[i],
-                             &d->userdata[i], NULL);
-  }
+  gs_physics_equilibrate_tendons(m, d, map.fT_col);  // tendon forces not given
   mj_forward(m, d);
   printf("%s at t = %.4f s of %s\n", path, time, pose);
   printf("%-16s %-7s %8s %8s %7s %9s %9s  %s\n", "muscle", "tendon", "lMT (m)", "lM (m)",

@@ -12,7 +12,6 @@
 #include "app/gs_app_model.h"
 #include "app/gs_commands.h"
 #include "callbacks/gs_model_info.h"
-#include "callbacks/gs_muscle.h"
 #include "callbacks/gs_physics.h"
 #include "callbacks/gs_state.h"
 #include "io/gs_atomic.h"
@@ -161,18 +160,8 @@ static int initial_state(const mjModel* m, mjData* d, const gsSimulateOptions* o
     d->qpos[m->jnt_qposadr[slide]] += o->drop * (d->xaxis[3 * slide + 2] > 0 ? 1 : -1);
   }
   mj_fwdPosition(m, d);
-  for (int i = 0; i < m->nu; i++) {  // elastic tendons without a given state: static equilibrium
-    gsMuscleParams prm;
-    int given = o->init && map.fT_col && map.fT_col[i] >= 0;
-    if (given || !gs_actuator_has_elastic_tendon(m, i) ||
-        gs_muscle_params_from_user(m->actuator_user + i * m->nuser_actuator, &prm, NULL, 0) != 0) {
-      continue;
-    }
-    double fT = 0;
-    double a = i >= m->nu - m->na ? d->act[i - (m->nu - m->na)] : 0;
-    gs_muscle_equilibrium_fT(&prm, a, d->actuator_length[i], &fT, NULL);
-    d->userdata[i] = fT;
-  }
+  // elastic tendons without a given state: static equilibrium
+  gs_physics_equilibrate_tendons(m, d, o->init ? map.fT_col : NULL);
   gs_state_map_free(&map);
   gs_table_free(&init);
   return 0;

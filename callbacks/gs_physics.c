@@ -73,6 +73,20 @@ static mjtNum gs_act_bias_callback(const mjModel* m, const mjData* d, int i) {
   return -gs_physics_muscle_tension(m, d, i, NULL);
 }
 
+void gs_physics_equilibrate_tendons(const mjModel* m, mjData* d, const int* given) {
+  for (int i = 0; i < m->nu; i++) {
+    gsMuscleParams prm;
+    if ((given && given[i] >= 0) || !gs_actuator_has_elastic_tendon(m, i) ||
+        gs_muscle_params_from_user(actuator_user(m, i), &prm, NULL, 0) != 0) {
+      continue;
+    }
+    double a = i >= m->nu - m->na ? actuator_activation(m, d, i) : 0;
+    double fT = 0;
+    gs_muscle_equilibrium_fT(&prm, a, d->actuator_length[i], &fT, NULL);
+    d->userdata[i] = fT;
+  }
+}
+
 int gs_physics_tendon_force_rates(const mjModel* m, const mjData* d, mjtNum* fT_dot) {
   int clamped = 0;
   for (int i = 0; i < m->nu; i++) {

@@ -48,6 +48,13 @@ double gs_physics_muscle_tension(const mjModel* m, const mjData* d, int i, gsMus
 double gs_physics_muscle_metabolics(const mjModel* m, const mjData* d, int i,
                                     gsUmbergerTerms* terms);
 
+// Static equilibrium of the elastic tendons: for every elastic-tendon muscle i whose state is
+// not given (given == NULL or given[i] < 0), set d->userdata[i] to the normalised tendon force in
+// Hill equilibrium at zero velocity for its activation and actuator length
+// (gs_muscle_equilibrium_fT). Needs mj_fwdPosition. given: per actuator (nu), e.g. a state
+// file's column map (gsStateMap.fT_col).
+void gs_physics_equilibrate_tendons(const mjModel* m, mjData* d, const int* given);
+
 // Normalised tendon-force rate dfT/dt (1/s) of every elastic-tendon muscle at the current state,
 // from the Hill equilibrium (forward model), into fT_dot (nu; 0 for other actuators). Needs
 // mj_fwdPosition and mj_fwdVelocity. Returns the number of muscles whose equilibrium was clamped.

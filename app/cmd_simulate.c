@@ -259,10 +259,13 @@ int gs_cmd_simulate(int argc, char** argv) {
       }
       row++;
     }
+    // the step's start time, taken before stepping: MuJoCo's reset on a bad acceleration
+    // rewinds d->time
+    double t_start = d->time - t0;
     if (s < steps && gs_physics_step(m, d, fT_dot) != 0) {
       finite = 0;
-      fprintf(stderr, "gaitsim: simulate: state became non-finite at t = %.4f s; writing the %d rows before it\n",
-              d->time - t0, row);
+      fprintf(stderr, "gaitsim: simulate: state became non-finite in the step from t = %.4f s; writing the %d rows before it\n",
+              t_start, row);
       break;
     }
   }

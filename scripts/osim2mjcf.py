@@ -80,6 +80,12 @@ GAIT2392_NAME = {
     "tibpost": "tib_post", "vasint": "vas_int", "vaslat": "vas_lat", "vasmed": "vas_med",
 }
 
+# relative excess of a right muscle's trial-mean length ratio over its left counterpart's above
+# which its tendon slack length is recalibrated (calibrate_right_tendon_slack)
+OVERSTRETCH_TOL = 0.03
+# largest normalised fibre length (tendon at slack) allowed anywhere in the trial
+# (cap_fibre_stretch)
+LM_MAX_TRIAL = 1.3
 MUSCLE_DENSITY = 1059.7   # kg/m^3 (Umberger et al. 2003)
 VMAX = 10.0               # lopt/s
 TAU_ACT = 0.010           # s
@@ -939,6 +945,72 @@ def read_metabolic(path):
     return out
 
 
+def calibrate_right_tendon_slack(model, frames):
+    """Recalibrate overstretched right-leg tendon slack lengths against the left leg
+    (mjmodels/README.md, "Right-leg tendon slack lengths"). JW's .osim routes the right (JW-named,
+    Schutte) quadriceps over the patella to the tibial tuberosity and places the soleus and
+    peronei origins differently from the left (gait2392) leg, but keeps tendon slack lengths no
+    longer than the left's, so those right muscle-tendon units sit 14-39 % beyond
+    lopt cos(alpha0) + lts at rest (normalised tendon forces of 4-11). Rule: with the length ratio
+    rho = mean(L) / (lopt cos(alpha0) + lts) over the trial, a right muscle whose rho exceeds its
+    left counterpart's (GAIT2392_NAME) by more than OVERSTRETCH_TOL gets the lts that makes the
+    two equal:
+        lts_r = mean(L_r) / rho_l - lopt_r cos(alpha_r).
+    Only overstretched muscles change, and only by lengthening the tendon; right muscles that are
+    relatively shorter (most hip muscles of the Schutte set) keep the .osim's lts (matching them
+    would make some lts negative). Straight-line .osim path lengths over every 4th trial frame,
+    the same geometry on both sides. Fmax, lopt and pennation stay the .osim's.
+    Returns [(name, rho_r, rho_l, old lts, new lts)] for the changed muscles."""
+    by_name = {mus["name"]: mus for mus in model.muscles}
+    poses = [pose for _, pose in frames[::4]]
+
+    def rho(mus):
+        length = sum(path_length(model, mus, pose) for pose in poses) / len(poses)
+        return length, length / (mus["lopt"] * math.cos(mus["pennation"]) + mus["lts"])
+
+    changes = []
+    for mus in model.muscles:
+        partner = by_name.get(GAIT2392_NAME.get(mus["name"], "") + "_l")
+        if partner is None:
+            continue
+        length_r, rho_r = rho(mus)
+        _, rho_l = rho(partner)
+        if rho_r <= rho_l * (1.0 + OVERSTRETCH_TOL):
+            continue
+        lts = length_r / rho_l - mus["lopt"] * math.cos(mus["pennation"])
+        changes.append((mus["name"], rho_r, rho_l, mus["lts"], lts))
+        mus["lts_osim"] = mus["lts"]
+        mus["lts"] = lts
+    return changes
+
+
+def cap_fibre_stretch(model, frames):
+    """Lengthen any tendon whose muscle would be stretched beyond LM_MAX_TRIAL optimal fibre
+    lengths somewhere in the trial (mjmodels/README.md, "Tendon slack lengths"). With the tendon
+    at slack length (no tendon strain) and constant-thickness pennation the normalised fibre
+    length is lM/lopt = sqrt((L - lts)^2 + (lopt sin alpha0)^2) / lopt; its largest value over
+    every 2nd trial frame must not exceed LM_MAX_TRIAL, else lts is raised so that it equals it:
+        lts = L_max - sqrt((LM_MAX_TRIAL lopt)^2 - (lopt sin alpha0)^2).
+    Without the cap, JW's scaled geometry leaves soleus, tibialis posterior, piriformis and
+    gluteus minimus at 1.4-1.9 lopt in stance, whose passive forces (up to 3 kN) no antagonist can
+    balance. Applied to every muscle after calibrate_right_tendon_slack. Straight-line .osim path
+    lengths. Returns [(name, largest lM/lopt before, old lts, new lts)] for the changed muscles."""
+    poses = [pose for _, pose in frames[::2]]
+    changes = []
+    for mus in model.muscles:
+        lopt, lts = mus["lopt"], mus["lts"]
+        height = lopt * math.sin(mus["pennation"])
+        longest = max(path_length(model, mus, pose) for pose in poses)
+        stretch = math.sqrt((longest - lts) ** 2 + height ** 2) / lopt
+        if stretch <= LM_MAX_TRIAL:
+            continue
+        new = longest - math.sqrt((LM_MAX_TRIAL * lopt) ** 2 - height ** 2)
+        changes.append((mus["name"], stretch, lts, new))
+        mus.setdefault("lts_osim", lts)
+        mus["lts"] = new
+    return changes
+
+
 def metabolic_key(name):
     """JW muscle name -> row of the 3dpredictsim table (right-leg rows serve both legs)."""
     if name in ("ercspn_r", "ercspn_l", "intobl_r", "intobl_l", "extobl_r", "extobl_l"):
@@ -1376,6 +1448,12 @@ def main():
     frames = read_trial(trial)
     metabolic = read_metabolic(os.path.join(args.muscle_params,
                                             "MTparameters_subject1_with_metabolic_params.csv"))
+    for name, rho_r, rho_l, old, new in calibrate_right_tendon_slack(model, frames):
+        print("lts %-11s rho %.3f (left %.3f): %.4f -> %.4f m (%+.1f %%)" % (
+            name, rho_r, rho_l, old, new, 100.0 * (new / old - 1.0)))
+    for name, stretch, old, new in cap_fibre_stretch(model, frames):
+        print("lts %-11s lM/lopt max %.3f: %.4f -> %.4f m (%+.1f %%)" % (
+            name, stretch, old, new, 100.0 * (new / old - 1.0)))
     conv = Converter(model, metabolic, frames, os.path.basename(args.osim))
     conv.write(args.out)
     write_reference(model, frames, args.reference_out,

@@ -9,5 +9,6 @@ const gsCommand gs_commands[] = {
     {"simulate", gs_cmd_simulate, "forward simulation with gaitsim's muscles and foot contact"},
     {"inspect", gs_cmd_inspect, "one row per muscle at one instant: lengths, force, metabolics, moment arms"},
     {"track", gs_cmd_track, "tracking solve of one stride by direct collocation"},
+    {"render", gs_cmd_render, "headless gait video, picture or filmstrip of a solution (OSMesa)"},
     {NULL, NULL, NULL},
 };

@@ -1433,6 +1433,30 @@ def write_reference(model, frames, path, poses_path, osim_name, trial_name):
     write_atomic(poses_path, "\n".join(pose_lines) + "\n")
 
 
+def add_knee_params(xml_path, params_path):
+    """--knee-params: insert the gs_knee <custom> numerics of mjmodels/knee/jw_knee.json
+    (scripts/prepare_knee.py knee_custom_snippet) into the written model and remove the right
+    knee's placeholder springs (stiffness/springref of knee_rotation, knee_adduction, knee_tx,
+    knee_ty, knee_tz; their damping stays). Rewrites xml_path atomically."""
+    import json
+    import re
+    from prepare_knee import knee_custom_snippet
+    with open(params_path, encoding="utf-8") as f:
+        params = json.load(f)
+    with open(xml_path, encoding="utf-8") as f:
+        text = f.read()
+    for name in ("knee_rotation", "knee_adduction", "knee_tx", "knee_ty", "knee_tz"):
+        text, n = re.subn(r'(<joint name="%s"[^>]*?) stiffness="[^"]*" springref="[^"]*"' % name,
+                          r"\1", text)
+        if n != 1:
+            raise SystemExit("osim2mjcf.py: %s: joint %s placeholder spring not found" % (
+                xml_path, name))
+    if "</mujoco>" not in text:
+        raise SystemExit("osim2mjcf.py: %s: no </mujoco>" % xml_path)
+    text = text.replace("</mujoco>", knee_custom_snippet(params) + "</mujoco>", 1)
+    write_atomic(xml_path, text)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--osim", required=True)
@@ -1441,6 +1465,8 @@ def main():
     ap.add_argument("--reference-out", required=True)
     ap.add_argument("--trial-ik", default=None,
                     help="IK csv (default: <osim dir>/../ngait_og5/IK_ngait_og5.csv)")
+    ap.add_argument("--knee-params", default=None,
+                    help="mjmodels/knee/jw_knee.json: add the gs_knee numerics (opt-in)")
     args = ap.parse_args()
     trial = args.trial_ik or os.path.join(os.path.dirname(os.path.abspath(args.osim)), "..",
                                           "ngait_og5", "IK_ngait_og5.csv")
@@ -1456,6 +1482,8 @@ def main():
             name, stretch, old, new, 100.0 * (new / old - 1.0)))
     conv = Converter(model, metabolic, frames, os.path.basename(args.osim))
     conv.write(args.out)
+    if args.knee_params:
+        add_knee_params(args.out, args.knee_params)
     write_reference(model, frames, args.reference_out,
                     os.path.join(os.path.dirname(args.reference_out), "jw_poses.csv"),
                     os.path.basename(args.osim), os.path.basename(trial))

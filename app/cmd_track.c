@@ -29,23 +29,50 @@ static const char* kTrackUsage =
     "short (its best iterate is written).\n\n"
     "  --model FILE        MJCF model (default: mjmodels/jw_fullbody.xml)\n"
     "  --nodes N           collocation nodes (default 80)\n"
+    "  --init DIR          start from the solution in DIR (states.sto, controls.sto), e.g. a\n"
+    "                      solve on fewer nodes, interpolated to N (default: the trial)\n"
     "  --threads N         worker threads (default 2)\n"
     "  --max-iter N        Ipopt iteration limit (default 1000)\n"
     "  --max-time S        wall-clock limit, s (default none)\n"
     "  --activation A      initial activations and excitations (default 0.05)\n"
+    "  --hessian H         lbfgs (default: Ipopt's limited-memory quasi-Newton) or gauss-newton\n"
+    "                      (exact for the tracking squares, constraint curvature left out)\n"
+    "  --weight NAME=W     goal weight, NAME one of pelvis_rot (default 10), pelvis_trans (10),\n"
+    "                      joint (1), grf (10), effort (0.1) (repeatable); each tracking group is\n"
+    "                      a mean of squared errors over 5 deg, 2 cm or 0.1 BW\n"
     "  --ipopt KEY=VALUE   extra Ipopt option (repeatable)\n";
 
 typedef struct {
   const char* trial;   // trial folder
   const char* out;     // output folder
   const char* model;   // MJCF path
+  const char* init;    // solution folder to start from (NULL: the trial)
   int nodes;           // collocation nodes
   int threads;         // workers
   int max_iter;        // iteration limit
   double max_time;     // wall limit (s), <= 0: none
   double activation;   // initial activation (-)
   go_ipopt_opts ipopt; // solver options
+  double w_pelvis_rot, w_pelvis_trans, w_joint, w_grf, w_effort;  // goal weights (-)
 } gsTrackOptions;
+
+// --weight NAME=VALUE
+static int parse_weight(const char* arg, gsTrackOptions* o) {
+  static const char* names[] = {"pelvis_rot", "pelvis_trans", "joint", "grf", "effort"};
+  double* slots[] = {&o->w_pelvis_rot, &o->w_pelvis_trans, &o->w_joint, &o->w_grf, &o->w_effort};
+  const char* eq = strchr(arg, '=');
+  if (!eq) return -1;
+  for (int i = 0; i < 5; i++) {
+    if (strlen(names[i]) == (size_t)(eq - arg) && strncmp(arg, names[i], (size_t)(eq - arg)) == 0) {
+      char* end;
+      double v = strtod(eq + 1, &end);
+      if (*end || end == eq + 1 || !(v >= 0) || !isfinite(v)) return -1;
+      *slots[i] = v;
+      return 0;
+    }
+  }
+  return -1;
+}
 
 static int parse_int(const char* s, int lo, int* v) {
   char* end;
@@ -56,11 +83,14 @@ static int parse_int(const char* s, int lo, int* v) {
 }
 
 static int parse(int argc, char** argv, gsTrackOptions* o) {
+  char err[256];
   static const struct option options[] = {
       {"out", required_argument, NULL, 'o'},      {"model", required_argument, NULL, 'm'},
       {"nodes", required_argument, NULL, 'n'},    {"threads", required_argument, NULL, 't'},
       {"max-iter", required_argument, NULL, 'i'}, {"max-time", required_argument, NULL, 'T'},
       {"activation", required_argument, NULL, 'a'}, {"ipopt", required_argument, NULL, 'p'},
+      {"hessian", required_argument, NULL, 'H'},  {"weight", required_argument, NULL, 'w'},
+      {"init", required_argument, NULL, 'I'},
       {"help", no_argument, NULL, 'h'},           {NULL, 0, NULL, 0}};
   memset(o, 0, sizeof(*o));
   o->model = GS_DEFAULT_MODEL;
@@ -69,10 +99,23 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
   o->max_iter = 1000;
   o->activation = 0.05;
   go_ipopt_opts_default(&o->ipopt);
+  o->ipopt.gauss_newton = 0;
+  // stopping rule (overridable with --ipopt): feasible to 1e-6 (scaled) and the objective
+  // settled to 1e-4 relative over 15 iterations, or Ipopt's own optimality at tol 1e-4
+  static const char* stop_rule[][2] = {
+      {"tol", "1e-4"},          {"constr_viol_tol", "1e-6"},
+      {"acceptable_tol", "1"},  {"acceptable_constr_viol_tol", "1e-6"},
+      {"acceptable_compl_inf_tol", "1e-3"}, {"acceptable_obj_change_tol", "1e-4"},
+      {"acceptable_iter", "15"}, {"limited_memory_max_history", "20"}};
+  for (size_t i = 0; i < sizeof(stop_rule) / sizeof(stop_rule[0]); i++)
+    go_ipopt_opts_set(&o->ipopt, stop_rule[i][0], stop_rule[i][1], err, sizeof(err));
+  o->w_pelvis_rot = o->w_pelvis_trans = o->w_grf = 10.0;
+  o->w_joint = 1.0;
+  o->w_effort = 0.1;
   optind = 1;
   int c;
-  char err[256], *end;
-  while ((c = getopt_long(argc, argv, "o:m:n:t:i:T:a:p:h", options, NULL)) != -1) {
+  char *end;
+  while ((c = getopt_long(argc, argv, "o:m:n:t:i:T:a:p:H:w:I:h", options, NULL)) != -1) {
     switch (c) {
       case 'o': o->out = optarg; break;
       case 'm': o->model = optarg; break;
@@ -99,6 +142,15 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
           return -1;
         }
         break;
+      case 'H':
+        if (strcmp(optarg, "gauss-newton") == 0) o->ipopt.gauss_newton = 1;
+        else if (strcmp(optarg, "lbfgs") == 0) o->ipopt.gauss_newton = 0;
+        else return -1;
+        break;
+      case 'w':
+        if (parse_weight(optarg, o)) return -1;
+        break;
+      case 'I': o->init = optarg; break;
       case 'h': fputs(kTrackUsage, stdout); exit(GS_EXIT_OK);
       default: return -1;
     }
@@ -109,6 +161,33 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
 }
 
 static double sq(double x) { return x * x; }
+
+// Scale the measured ground reactions (force and free-torque columns) so that their stride-mean
+// total vertical force equals the model's weight, and return the factor. The force plates imply
+// 65.85 kg for JW's trial against the scaled model's 62.64 kg; a periodic solve can only
+// average m g, so unscaled data would leave a constant vertical offset of 0.05 BW. Tracking and
+// the reported RMS errors are thereby in each one's own body weights (the paper's BW). Returns
+// 0 when the table has no vertical force columns or no positive mean.
+static double normalise_grf_to_weight(gsTable* grf, double weight) {
+  int cr = gs_table_column(grf, "ground_force_r_vy"), cl = gs_table_column(grf, "ground_force_l_vy");
+  if (cr < 0 || cl < 0 || grf->nrow < 2) return 0;
+  double area = 0, span = grf->time[grf->nrow - 1] - grf->time[0];
+  for (int i = 0; i + 1 < grf->nrow; i++) {
+    double a = grf->data[i * grf->ncol + cr] + grf->data[i * grf->ncol + cl];
+    double b = grf->data[(i + 1) * grf->ncol + cr] + grf->data[(i + 1) * grf->ncol + cl];
+    area += 0.5 * (a + b) * (grf->time[i + 1] - grf->time[i]);
+  }
+  if (!(area > 0 && span > 0)) return 0;
+  double factor = weight / (area / span);
+  for (int j = 0; j < grf->ncol; j++) {
+    const char* lab = grf->labels[j];
+    int force = strncmp(lab, "ground_force_", 13) == 0 && strstr(lab, "_v") != NULL;
+    int torque = strncmp(lab, "ground_torque_", 14) == 0;
+    if (!force && !torque) continue;
+    for (int i = 0; i < grf->nrow; i++) grf->data[i * grf->ncol + j] *= factor;
+  }
+  return factor;
+}
 
 // write the solution tables and accumulate the RMS errors into summary
 static int write_solution(go_gait* g, const double* z, const char* out, cJSON* summary) {
@@ -231,6 +310,30 @@ static void print_blocks(go_gait* g, const double* gv, const char* when) {
   fprintf(stderr, "\n");
 }
 
+// initial guess from the solution folder dir (states.sto, controls.sto); prints the reason
+static int guess_from_folder(go_gait* g, const mjModel* m, const char* dir, double activation,
+                             double* z) {
+  gsTable states, controls;
+  gs_table_init(&states);
+  gs_table_init(&controls);
+  char path[4096], err[512];
+  int rc = -1;
+  snprintf(path, sizeof(path), "%s/states.sto", dir);
+  if (gs_app_read_table(m, path, &states) != 0) goto done;
+  snprintf(path, sizeof(path), "%s/controls.sto", dir);
+  if (gs_app_read_table(m, path, &controls) != 0) goto done;
+  if (go_gait_guess_from_solution(g, &states, &controls, 1.0, activation, z, err,
+                                  sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s: %s\n", dir, err);
+    goto done;
+  }
+  rc = 0;
+done:
+  gs_table_free(&states);
+  gs_table_free(&controls);
+  return rc;
+}
+
 int gs_cmd_track(int argc, char** argv) {
   gsTrackOptions o;
   if (parse(argc, argv, &o) != 0) {
@@ -255,6 +358,15 @@ int gs_cmd_track(int argc, char** argv) {
     fprintf(stderr, "gaitsim: %s: %s\n", o.out, err);
     goto done;
   }
+  double model_weight = 0;
+  for (int b = 1; b < m->nbody; b++) model_weight += m->body_mass[b];
+  model_weight *= mju_norm3(m->opt.gravity);
+  double grf_scale = normalise_grf_to_weight(&grf, model_weight);
+  if (!(grf_scale > 0)) {
+    fprintf(stderr, "gaitsim: %s/grf.mot: no positive vertical ground reaction to normalise\n",
+            o.trial);
+    goto done;
+  }
   go_gait_opts go;
   go_gait_opts_default(&go);
   static const char* free_coords[] = {"pelvis_tz", NULL};  // the trial drifts sideways
@@ -263,6 +375,11 @@ int gs_cmd_track(int argc, char** argv) {
   go.coords = &coords;
   go.grf = &grf;
   go.free_coords = free_coords;
+  go.w_pelvis_rot = o.w_pelvis_rot;
+  go.w_pelvis_trans = o.w_pelvis_trans;
+  go.w_joint = o.w_joint;
+  go.w_grf = o.w_grf;
+  go.w_effort = o.w_effort;
   if (go_gait_create(&g, m, &go, err, sizeof(err)) != 0) {
     fprintf(stderr, "gaitsim: track: %s\n", err);
     goto done;
@@ -274,7 +391,9 @@ int gs_cmd_track(int argc, char** argv) {
   zb = (double*)malloc(sizeof(double) * (size_t)n);
   zs = (double*)malloc(sizeof(double) * (size_t)n);
   gv = (double*)malloc(sizeof(double) * (size_t)mm);
-  if (go_gait_guess_from_trial(g, &coords, o.activation, z, err, sizeof(err)) != 0) {
+  if (o.init) {
+    if (guess_from_folder(g, m, o.init, o.activation, z) != 0) goto done;
+  } else if (go_gait_guess_from_trial(g, &coords, o.activation, z, err, sizeof(err)) != 0) {
     fprintf(stderr, "gaitsim: track: %s\n", err);
     goto done;
   }
@@ -312,6 +431,7 @@ int gs_cmd_track(int argc, char** argv) {
   cJSON_AddNumberToObject(summary, "nodes", o.nodes);
   cJSON_AddNumberToObject(summary, "threads", o.threads);
   cJSON_AddNumberToObject(summary, "stride_time_s", go_gait_stride_time(g));
+  cJSON_AddNumberToObject(summary, "grf_scale", grf_scale);
   cJSON_AddNumberToObject(summary, "objective", zout == z ? res.objective : res.best_objective);
   cJSON_AddNumberToObject(summary, "initial_violation", viol0);
   cJSON_AddNumberToObject(summary, "max_violation", viol);

@@ -44,6 +44,11 @@ typedef int (*go_integrand_fn)(void* ctx, int k, const double* z_k, double* L);
 // must be 0)
 typedef int (*go_integrand_grad_fn)(void* ctx, int k, const double* z_k, double* dL);
 
+// diagonal of the integrand's Hessian at node k: d2L (nz, dense) with d2L[j] = d2L/dz_k[j]^2, for
+// an integrand that is a sum of functions of one variable each (tracking and effort squares);
+// enables the Gauss-Newton Hessian (go_nlp_eval_hess_diag)
+typedef int (*go_integrand_hess_fn)(void* ctx, int k, const double* z_k, double* d2L);
+
 // boundary constraints b (n_boundary) from the first and last node variables and T
 typedef int (*go_boundary_fn)(void* ctx, const double* z_first, const double* z_last, double T,
                               double* b);
@@ -107,6 +112,7 @@ typedef struct {
   const int* integrand_vars;             // node variables L depends on (n_integrand_vars)
   int n_integrand_vars;
   go_integrand_grad_fn integrand_grad;   // optional analytic gradient (else central differences)
+  go_integrand_hess_fn integrand_hess;   // optional diagonal Hessian (Gauss-Newton Hessian)
   go_outer_fn outer;                     // optional, NULL: J = I
 
   // boundary constraints

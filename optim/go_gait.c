@@ -307,6 +307,17 @@ static int integrand_grad_cb(void* vctx, int k, const double* z, double* dL) {
   return 0;
 }
 
+// diagonal Hessian of the integrand (it is a sum of squares of single variables)
+static int integrand_hess_cb(void* vctx, int k, const double* z, double* d2L) {
+  const go_gait* g = ((gait_ctx*)vctx)->g;
+  const go_gait_layout* L = &g->L;
+  memset(d2L, 0, sizeof(double) * (size_t)L->nz);
+  for (int j = 0; j < L->nv; j++) d2L[L->x_q + j] = 2 * g->q_wt[j];
+  for (int c = 0; c < GO_GAIT_NGRF; c++) d2L[L->u_grf + c] = 2 * g->w_grf;
+  for (int i = 0; i < L->na; i++) d2L[L->u_e + i] = 2 * g->w_effort;
+  return 0;
+}
+
 static int outer_cb(void* ctx, double I, double T, double* J, double* dJdI, double* dJdT) {
   *J = I / T;
   *dJdI = 1.0 / T;
@@ -836,6 +847,7 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   p.integrand_vars = g->ivars;
   p.n_integrand_vars = g->n_ivars;
   p.integrand_grad = integrand_grad_cb;
+  p.integrand_hess = integrand_hess_cb;
   p.outer = outer_cb;
   p.boundary = g->n_bnd > 0 ? boundary_cb : NULL;
   p.bnd_col_ptr = g->bnd_col_ptr;

@@ -20,4 +20,18 @@
 int go_gait_guess_from_trial(const go_gait* g, const gsTable* coords, double activation,
                              double* z, char* err, int errsz);
 
+// Fill z (N nz, physical) from a solution of a gait problem on the same model, e.g. the same
+// problem on fewer nodes (mesh continuation) or a tracking solution as the guess of a prediction:
+// states (gs_state.h columns, radians: coordinates, speeds, activations, tendon forces; time
+// spanning the stride) and controls (excitations), both linearly interpolated at the node times
+// t_k = t_0 + T' k / (N - 1) with T' = the states' time span times time_scale (> 0; 1 keeps the
+// stride, 0.8 makes it 20 % shorter, with speeds and derivatives scaled by 1/time_scale and the
+// forward translation kept). Missing quantities as in go_gait_guess_from_trial (activation
+// `activation`, tendon forces in equilibrium). q' = qdot; qddot, adot and fT' by periodic
+// central differences over the nodes; ground reaction variables from the model's contact. Returns
+// 0, or -1 with the reason in err.
+int go_gait_guess_from_solution(const go_gait* g, const gsTable* states, const gsTable* controls,
+                                double time_scale, double activation, double* z, char* err,
+                                int errsz);
+
 #endif  // GAITSIM_OPTIM_GO_GAIT_GUESS_H_

@@ -36,6 +36,9 @@ typedef struct {
   double best_viol_tol;   // violations at or below count as feasible for the best iterate
   FILE* progress;         // one line per iteration; NULL: silent
   int handle_sigint;      // 1: Ctrl-C stops the solve cleanly (handler restored afterwards)
+  int gauss_newton;       // 1: Ipopt's exact-Hessian mode with the Gauss-Newton Hessian
+                          // (go_nlp_eval_hess_diag; the problem needs integrand_hess);
+                          // 0: limited-memory quasi-Newton (L-BFGS)
   int n_kv;               // extra Ipopt options, applied after all of the above, in order
   go_ipopt_kv kv[GO_IPOPT_MAX_OPTIONS];
 } go_ipopt_opts;

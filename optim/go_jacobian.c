@@ -296,6 +296,56 @@ int go_nlp_eval_grad_f(go_nlp* nlp, const double* zs, double* grad) {
   return 0;
 }
 
+// --- Gauss-Newton Hessian ---------------------------------------------------------------------
+
+int go_nlp_has_hess_diag(const go_nlp* nlp) {
+  return nlp->prob.integrand != NULL && nlp->prob.integrand_hess != NULL;
+}
+
+int go_nlp_eval_hess_diag(go_nlp* nlp, const double* zs, double obj_factor, double* diag) {
+  int nz = nlp->nz, N = nlp->N;
+  if (!go_nlp_has_hess_diag(nlp)) {
+    snprintf(nlp->err, sizeof(nlp->err), "Gauss-Newton Hessian: the problem has no integrand_hess");
+    return -1;
+  }
+  // integrand at every node for outer()'s dJ/dI (serial: N cheap evaluations)
+  double T = go_nlp_time(nlp, zs), h = T / (N - 1), S = 0.0, J, dJdI = 1.0, dJdT;
+  for (int k = 0; k < N; k++) {
+    double L;
+    if (go_nlp_node_L(nlp, 0, k, zs, &L)) {
+      snprintf(nlp->err, sizeof(nlp->err), "Gauss-Newton Hessian: integrand failed at node %d", k);
+      return -1;
+    }
+    S += go_nlp_weight(nlp, k) * L;
+  }
+  if (nlp->prob.outer &&
+      (nlp->prob.outer(go_nlp_ctx(nlp, 0), S * h, T, &J, &dJdI, &dJdT) != 0 || !isfinite(dJdI))) {
+    snprintf(nlp->err, sizeof(nlp->err), "objective outer(): failed or non-finite");
+    return -1;
+  }
+  // node diagonals, in the solver's scaling
+  go_worker* wk = &nlp->workers[0];
+  for (int k = 0; k < N; k++) {
+    const double* zk = zs + (size_t)k * (size_t)nz;
+    for (int j = 0; j < nz; j++) wk->z[j] = zk[j] * nlp->zscale[j];
+    double* dk = diag + (size_t)k * (size_t)nz;
+    if (nlp->prob.integrand_hess(go_nlp_ctx(nlp, 0), k, wk->z, dk) != 0) {
+      snprintf(nlp->err, sizeof(nlp->err), "Gauss-Newton Hessian: integrand_hess failed at node %d", k);
+      return -1;
+    }
+    double c = obj_factor * dJdI * go_nlp_weight(nlp, k) * h / nlp->obj_scale;
+    for (int j = 0; j < nz; j++) {
+      dk[j] *= c * nlp->zscale[j] * nlp->zscale[j];
+      if (!isfinite(dk[j])) {
+        snprintf(nlp->err, sizeof(nlp->err), "Gauss-Newton Hessian: non-finite at node %d", k);
+        return -1;
+      }
+    }
+  }
+  if (nlp->free_time) diag[N * nz] = 0.0;
+  return 0;
+}
+
 void go_nlp_set_jac_mode(go_nlp* nlp, go_jac_mode mode) { nlp->mode = mode; }
 
 int go_nlp_path_groups(const go_nlp* nlp) { return nlp->ngroup; }

@@ -28,6 +28,17 @@ int go_nlp_eval_jac(go_nlp* nlp, const double* zs, double* vals);
 // With GO_JAC_DENSE: central differences of the whole objective over every variable.
 int go_nlp_eval_grad_f(go_nlp* nlp, const double* zs, double* grad);
 
+// Gauss-Newton Hessian of the Lagrangian, for Ipopt's exact-Hessian mode: the diagonal (n) of
+// obj_factor times the Hessian of the objective, from integrand_hess,
+//   d2J/dz~_j^2 = dJ/dI h w_k d2L_k/dz_kj^2 z_scale_j^2 / obj_scale,
+// and 0 in the T column. The constraints' curvature (the lambda terms) and outer()'s own curvature
+// are left out: exact for a tracking objective (squares of variables) under linear constraints,
+// the constrained Gauss-Newton method otherwise (Bock's generalised Gauss-Newton), which converges
+// fast when the tracking residuals and multipliers are small. 0, or -1 without integrand_hess or
+// when a callback fails (go_nlp_last_error).
+int go_nlp_eval_hess_diag(go_nlp* nlp, const double* zs, double obj_factor, double* diag);
+int go_nlp_has_hess_diag(const go_nlp* nlp);
+
 // choose sparse (default) or dense (baseline) finite differences
 void go_nlp_set_jac_mode(go_nlp* nlp, go_jac_mode mode);
 

@@ -18,6 +18,7 @@ int gs_cmd_simulate(int argc, char** argv);
 int gs_cmd_track(int argc, char** argv);
 int gs_cmd_inspect(int argc, char** argv);
 int gs_cmd_render(int argc, char** argv);
+int gs_cmd_report(int argc, char** argv);
 
 // The table of subcommands, terminated by an entry with name NULL.
 extern const gsCommand gs_commands[];

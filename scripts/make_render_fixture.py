@@ -18,22 +18,7 @@ import sys
 import xml.etree.ElementTree as ET
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gs_scriptlib import PrepError, write_atomic  # noqa: E402
-
-
-def read_storage(path):
-    """(header lines, labels, rows) of an OpenSim storage file."""
-    with open(path, encoding="utf-8") as f:
-        lines = f.read().splitlines()
-    try:
-        end = lines.index("endheader")
-    except ValueError:
-        raise PrepError(path, "no endheader line")
-    labels = lines[end + 1].split("\t")
-    rows = [[float(x) for x in line.split()] for line in lines[end + 2:] if line.strip()]
-    if not rows or any(len(r) != len(labels) for r in rows):
-        raise PrepError(path, "rows do not match the labels")
-    return lines[:end], labels, rows
+from gs_scriptlib import PrepError, read_storage, write_atomic  # noqa: E402
 
 
 def storage_text(name, labels, rows, in_degrees, notes):

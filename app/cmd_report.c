@@ -1,0 +1,107 @@
+// cmd_report.c: `gaitsim report DIR [--out D] [--trial T]`: figures (PNG) and a Markdown table of
+// a solution folder, like Lin, Walter & Pandy 2018 Fig. 1-3 and Table 1. The work is done by
+// scripts/report.py (Debian python3-matplotlib), run as a child process without a shell; its exit
+// status is passed through.
+#include <errno.h>
+#include <getopt.h>
+#include <stdio.h>
+#include <string.h>
+#include <sys/types.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include "app/gs_commands.h"
+
+#define GS_REPORT_PYTHON "/usr/bin/python3"
+#define GS_REPORT_SCRIPT GAITSIM_SOURCE_DIR "/scripts/report.py"
+
+static const char* kReportUsage =
+    "usage: gaitsim report DIR [--out D] [--trial T]\n\n"
+    "Figures and a table for a solution folder DIR (states.sto, controls.sto, grf.mot,\n"
+    "summary.json; knee_contact.sto if present) against the measured trial it tracked, like Lin,\n"
+    "Walter & Pandy 2018 Fig. 1-3 and Table 1: kinematics.png, grf.png (BW), knee_contact.png\n"
+    "(when DIR has knee_contact.sto), excitations.png (right leg vs healthy EMG timing) and\n"
+    "report.md (RMS errors beside the paper's, solve facts, figure links). Each file is written\n"
+    "whole (temporary file + rename), and nothing is written on bad input. Needs Debian's\n"
+    "python3-matplotlib (" GS_REPORT_PYTHON ").\n\n"
+    "  --out D     output folder (default DIR/report)\n"
+    "  --trial T   measured trial folder (default: summary.json \"trial\", else\n"
+    "              mjmodels/trials/jw_ngait_og5)\n";
+
+int gs_cmd_report(int argc, char** argv) {
+  static const struct option options[] = {{"out", required_argument, NULL, 'o'},
+                                          {"trial", required_argument, NULL, 't'},
+                                          {"help", no_argument, NULL, 'h'},
+                                          {NULL, 0, NULL, 0}};
+  const char* out = NULL;
+  const char* trial = NULL;
+  optind = 1;
+  int c;
+  while ((c = getopt_long(argc, argv, "o:t:h", options, NULL)) != -1) {
+    switch (c) {
+      case 'o':
+        out = optarg;
+        break;
+      case 't':
+        trial = optarg;
+        break;
+      case 'h':
+        fputs(kReportUsage, stdout);
+        return GS_EXIT_OK;
+      default:
+        fputs(kReportUsage, stderr);
+        return GS_EXIT_USAGE;
+    }
+  }
+  if (optind != argc - 1) {
+    fputs(kReportUsage, stderr);
+    return GS_EXIT_USAGE;
+  }
+
+  // the child's arguments: python3 report.py DIR [--out D] [--trial T]; "--" keeps a DIR that
+  // starts with '-' a folder name
+  char* args[9];
+  int n = 0;
+  args[n++] = (char*)GS_REPORT_PYTHON;
+  args[n++] = (char*)GS_REPORT_SCRIPT;
+  if (out) {
+    args[n++] = (char*)"--out";
+    args[n++] = (char*)out;
+  }
+  if (trial) {
+    args[n++] = (char*)"--trial";
+    args[n++] = (char*)trial;
+  }
+  args[n++] = (char*)"--";
+  args[n++] = argv[optind];
+  args[n] = NULL;
+
+  // run it and wait; stdout is flushed first so nothing buffered is written twice
+  fflush(NULL);
+  pid_t pid = fork();
+  if (pid < 0) {
+    fprintf(stderr, "gaitsim: report: fork: %s\n", strerror(errno));
+    return GS_EXIT_FAILURE;
+  }
+  if (pid == 0) {
+    execv(GS_REPORT_PYTHON, args);
+    fprintf(stderr, "gaitsim: %s: %s (install python3-matplotlib)\n", GS_REPORT_PYTHON,
+            strerror(errno));
+    _exit(GS_EXIT_FAILURE);
+  }
+  int st = 0;
+  while (waitpid(pid, &st, 0) < 0) {
+    if (errno != EINTR) {
+      fprintf(stderr, "gaitsim: report: waitpid: %s\n", strerror(errno));
+      return GS_EXIT_FAILURE;
+    }
+  }
+  if (WIFSIGNALED(st)) {
+    fprintf(stderr, "gaitsim: report: %s killed by signal %d\n", GS_REPORT_SCRIPT, WTERMSIG(st));
+    return GS_EXIT_FAILURE;
+  }
+  if (!WIFEXITED(st)) return GS_EXIT_FAILURE;
+  int rc = WEXITSTATUS(st);
+  if (rc == GS_EXIT_OK || rc == GS_EXIT_USAGE) return rc;
+  return GS_EXIT_FAILURE;
+}

@@ -1,0 +1,98 @@
+#!/usr/bin/env bash
+# gaitsim report on a copy of the fixture solution (tests/fixtures/solution_small) with a
+# summary.json carrying RMS errors and solve facts: exit 0; kinematics, grf, knee_contact and
+# excitations PNGs with a valid signature and a plausible size; report.md has the Table 1 rows
+# with these numbers beside the paper's and links the figures; --out writes elsewhere; a folder
+# without states.sto, or with a NaN in a used column, exits 1 with one line naming the file and
+# writes no report.md; usage errors exit 2.
+# usage: report.sh GAITSIM SOURCE_DIR
+set -u
+gaitsim=$1 src=$2
+source "$(dirname "$0")/../cli_common.bash"
+
+png_info() {  # "ok WxH" for a file with the PNG signature and an IHDR chunk, else "bad"
+  python3 -c '
+import struct, sys
+d = open(sys.argv[1], "rb").read(24)
+ok = d[:8] == b"\x89PNG\r\n\x1a\n" and d[12:16] == b"IHDR"
+print("ok %dx%d" % struct.unpack(">II", d[16:24]) if ok else "bad")' "$1" 2>/dev/null || echo bad
+}
+plausible_png() {  # plausible_png FILE: valid PNG, 400..4000 px each way, over 10 kB
+  local info w h
+  info=$(png_info "$1")
+  [[ $info == ok\ * ]] || return 1
+  w=${info#ok } h=${w#*x} w=${w%x*}
+  test "$w" -ge 400 -a "$w" -le 4000 -a "$h" -ge 300 -a "$h" -le 4000 -a "$(stat -c %s "$1")" -gt 10000
+}
+
+cp -r "$src/tests/fixtures/solution_small" sol
+cat >sol/summary.json <<EOF
+{
+  "problem": "tracking",
+  "model": "$src/mjmodels/jw_fullbody.xml",
+  "trial": "$src/mjmodels/trials/jw_ngait_og5",
+  "status": "solved",
+  "iterations": 123,
+  "wall_s": 45.6,
+  "nodes": 14,
+  "stride_time_s": 1.1054841,
+  "grf_scale": 0.951,
+  "rms": {"pelvis_rot_deg": 0.345, "pelvis_trans_cm": 0.678, "grf_ap_bw": 0.0123,
+          "grf_v_bw": 0.0456, "grf_ml_bw": 0.0078, "joint_rot_deg": 2.34, "knee_contact_bw": null}
+}
+EOF
+
+out=$("$gaitsim" report sol)
+check "report exits 0" test $? -eq 0
+check "report names its folder" grep -q "sol/report" <<<"$out"
+for f in kinematics grf knee_contact excitations; do
+  check "$f.png is a plausible PNG ($(png_info sol/report/$f.png))" plausible_png sol/report/$f.png
+done
+md=sol/report/report.md
+check "report.md written" test -s $md
+check "row pelvis rotations" grep -q '^| Pelvis rotations | deg | 0.345 | 0.21 |$' $md
+check "row pelvis translations" grep -q '^| Pelvis translations | cm | 0.678 | 0.20 |$' $md
+check "row GRF fore-aft" grep -q '^| GRF fore-aft | BW | 0.0123 | 0.02 |$' $md
+check "row GRF vertical" grep -q '^| GRF vertical | BW | 0.0456 | 0.04 |$' $md
+check "row GRF mediolateral" grep -q '^| GRF mediolateral | BW | 0.0078 | 0.02 |$' $md
+check "row joint rotations" grep -q '^| Joint rotations | deg | 2.34 | 1.98 |$' $md
+check "row knee contact (null)" grep -q '^| Knee contact force | BW | n/a | 0.32 |$' $md
+check "solve facts" grep -q '^| status | solved |$' $md
+check "iterations" grep -q '^| iterations | 123 |$' $md
+check "wall time" grep -q '^| wall time (s) | 45.6 |$' $md
+check "links the figures" test "$(grep -c '^!\[.*\](\(kinematics\|grf\|knee_contact\|excitations\)\.png)$' $md)" -eq 4
+check "caption names the GRF scale" grep -q 'grf_scale = 0.9510' $md
+check "no temporary files left" test -z "$(ls -A sol/report | grep -v '^\(report\.md\|[a-z_]*\.png\)$')"
+
+# --out elsewhere; without knee_contact.sto there is no knee figure
+cp -r sol noknee && rm -rf noknee/report noknee/knee_contact.sto
+"$gaitsim" report noknee --out elsewhere >/dev/null
+check "--out exits 0" test $? -eq 0
+check "--out: report.md there" test -s elsewhere/report.md
+check "--out: nothing in DIR/report" test ! -e noknee/report
+check "no knee file: no knee figure" test ! -e elsewhere/knee_contact.png
+
+# a missing states.sto: exit 1, one line naming the file, no report.md
+cp -r sol bad && rm -rf bad/report bad/states.sto
+err=$("$gaitsim" report bad 2>&1 >/dev/null)
+check "missing states.sto exits 1" test $? -eq 1
+check "one line naming states.sto (got: $err)" test "$(wc -l <<<"$err")" -eq 1 -a -n "$(grep '^gaitsim: .*states\.sto: ' <<<"$err")"
+check "missing states.sto: nothing written" test ! -e bad/report
+
+# a NaN in a used column of controls.sto
+cp -r sol nan && rm -rf nan/report
+awk 'f && n++ == 3 {$39 = "nan"} {print} /^endheader/ {f = 1}' OFS='\t' sol/controls.sto >nan/controls.sto
+err=$("$gaitsim" report nan 2>&1 >/dev/null)
+check "NaN exits 1" test $? -eq 1
+check "NaN: one line naming controls.sto (got: $err)" test "$(wc -l <<<"$err")" -eq 1 -a -n "$(grep '^gaitsim: .*controls\.sto: column .*NaN' <<<"$err")"
+check "NaN: nothing written" test ! -e nan/report
+
+# usage
+"$gaitsim" report >/dev/null 2>&1
+check "no DIR exits 2" test $? -eq 2
+"$gaitsim" report sol --bogus >/dev/null 2>&1
+check "unknown option exits 2" test $? -eq 2
+"$gaitsim" report --help | grep -q '^usage: gaitsim report DIR'
+check "--help prints usage" test $? -eq 0
+
+finish

@@ -16,6 +16,7 @@
 #include "callbacks/gs_physics.h"
 #include "callbacks/gs_state.h"
 #include "io/gs_atomic.h"
+#include "io/gs_storage.h"
 #include "optim/go_gait.h"
 #include "optim/go_gait_guess.h"
 #include "optim/go_ipopt.h"
@@ -189,14 +190,33 @@ static double normalise_grf_to_weight(gsTable* grf, double weight) {
   return factor;
 }
 
-// write the solution tables and accumulate the RMS errors into summary
-static int write_solution(go_gait* g, const double* z, const char* out, cJSON* summary) {
+// Right (implant) knee contact force (N) at the loaded state d: the compressive axial force that
+// the knee_ty joint carries between tibial tray and femoral component. With the model's
+// placeholder knee (a stiff spring-damper on knee_ty, mjmodels/README.md) that is the spring-
+// damper force -(k (q - q_spring) + b qdot) along the joint axis; the axis points from the femoral
+// component to the tibial tray (-y of the femoral component), so compression (knee_ty below its
+// spring reference) gives a positive force. With the contact surrogate it will be the
+// surrogate's normal force. NAN without a knee_ty joint.
+static double knee_contact_total(const mjModel* m, const mjData* d) {
+  int j = mj_name2id(m, mjOBJ_JOINT, "knee_ty");
+  if (j < 0 || m->jnt_type[j] != mjJNT_SLIDE) return NAN;
+  int qa = m->jnt_qposadr[j], da = m->jnt_dofadr[j];
+  double spring = -m->jnt_stiffness[j] * (d->qpos[qa] - m->qpos_spring[qa]);
+  double damper = -m->dof_damping[da] * d->qvel[da];
+  return spring + damper;
+}
+
+// write the solution tables and accumulate the RMS errors into summary; knee_ref: measured
+// total knee contact force (N) at the nodes, or NULL
+static int write_solution(go_gait* g, const double* z, const char* out, const double* knee_ref,
+                          cJSON* summary) {
   const mjModel* m = go_gait_model(g);
   const go_gait_layout* L = go_gait_layout_get(g);
   int N = go_gait_nodes(g), nv = L->nv, na = L->na, status = -1;
   double T = go_gait_stride_time(g), bw = go_gait_weight(g);
   mjData* d = mj_makeData(m);
-  gsTable states, controls, grf, forces;
+  gsTable states, controls, grf, forces, knee;
+  gs_table_init(&knee);
   gs_table_init(&states);
   gs_table_init(&controls);
   gs_table_init(&grf);
@@ -207,19 +227,25 @@ static int write_solution(go_gait* g, const double* z, const char* out, cJSON* s
   if (gs_state_table_create(m, N, &states, err, sizeof(err)) != 0 ||
       gs_table_create(&controls, N, na, names, err, sizeof(err)) != 0 ||
       gs_grf_table_create(N, &grf, err, sizeof(err)) != 0 ||
-      gs_table_create(&forces, N, na, names, err, sizeof(err)) != 0) {
+      gs_table_create(&forces, N, na, names, err, sizeof(err)) != 0 ||
+      gs_table_create(&knee, N, 1, (const char*[]){"contact_total_r"}, err, sizeof(err)) != 0) {
     fprintf(stderr, "gaitsim: track: %s\n", err);
     goto done;
   }
   // sums of squares: pelvis rot, pelvis trans, joint rot, grf ap, v, ml; counts
-  double ss[6] = {0}, cnt[6] = {0};
+  double ss[7] = {0}, cnt[7] = {0};
   for (int k = 0; k < N; k++) {
     const double* zk = z + (size_t)k * L->nz;
     double t = T * k / (N - 1);
     go_gait_load_node(g, d, zk);
     gs_state_table_set_row(m, d, t, &states, k);
     gs_grf_table_set_row(m, d, t, &grf, k);
-    controls.time[k] = forces.time[k] = t;
+    controls.time[k] = forces.time[k] = knee.time[k] = t;
+    knee.data[k] = knee_contact_total(m, d);
+    if (knee_ref && isfinite(knee.data[k]) && isfinite(knee_ref[k])) {
+      ss[6] += sq((knee.data[k] - knee_ref[k]) / bw);
+      cnt[6]++;
+    }
     for (int i = 0; i < na; i++) {
       controls.data[k * na + i] = zk[L->u_e + i];
       forces.data[k * na + i] = gs_physics_muscle_tension(m, d, i, NULL);
@@ -251,10 +277,10 @@ static int write_solution(go_gait* g, const double* z, const char* out, cJSON* s
       }
     }
   }
-  static const char* keys[6] = {"pelvis_rot_deg", "pelvis_trans_cm", "joint_rot_deg",
-                                "grf_ap_bw", "grf_v_bw", "grf_ml_bw"};
+  static const char* keys[7] = {"pelvis_rot_deg", "pelvis_trans_cm", "joint_rot_deg",
+                                "grf_ap_bw", "grf_v_bw", "grf_ml_bw", "knee_contact_bw"};
   cJSON* rms = cJSON_AddObjectToObject(summary, "rms");
-  for (int q = 0; q < 6; q++) {
+  for (int q = 0; q < 7; q++) {
     if (cnt[q] > 0) cJSON_AddNumberToObject(rms, keys[q], sqrt(ss[q] / cnt[q]));
     else cJSON_AddNullToObject(rms, keys[q]);
   }
@@ -266,7 +292,8 @@ static int write_solution(go_gait* g, const double* z, const char* out, cJSON* s
   if (gs_app_write_table(out, "states.sto", &states) == 0 &&
       gs_app_write_table(out, "controls.sto", &controls) == 0 &&
       gs_app_write_table(out, "grf.mot", &grf) == 0 &&
-      gs_app_write_table(out, "muscle_forces.sto", &forces) == 0) {
+      gs_app_write_table(out, "muscle_forces.sto", &forces) == 0 &&
+      gs_app_write_table(out, "knee_contact.sto", &knee) == 0) {
     status = 0;
   }
 done:
@@ -275,6 +302,7 @@ done:
   gs_table_free(&controls);
   gs_table_free(&grf);
   gs_table_free(&forces);
+  gs_table_free(&knee);
   mj_deleteData(d);
   return status;
 }
@@ -308,6 +336,31 @@ static void print_blocks(go_gait* g, const double* gv, const char* when) {
   fprintf(stderr, "track: %s violation by block:", when);
   for (int b = 0; b < 7; b++) fprintf(stderr, " %s %.3g (#%d)", names[b], mx[b], at[b]);
   fprintf(stderr, "\n");
+}
+
+// measured total knee contact force (N) of the trial at the N node times (caller frees), or NULL
+// when the trial has no knee_contact.sto with a contact_total_r column
+static double* measured_knee_contact(const char* trial, const go_gait* g) {
+  char path[4096], err[256];
+  snprintf(path, sizeof(path), "%s/knee_contact.sto", trial);
+  gsTable t, rs;
+  gs_table_init(&t);
+  gs_table_init(&rs);
+  int N = go_gait_nodes(g);
+  double* out = NULL;
+  double* times = (double*)malloc(sizeof(double) * (size_t)N);
+  if (gs_storage_read(path, &t, err, sizeof(err)) == 0) {
+    int c = gs_table_column(&t, "contact_total_r");
+    for (int k = 0; k < N; k++) times[k] = t.time[0] + go_gait_stride_time(g) * k / (N - 1);
+    if (c >= 0 && gs_table_resample(&t, times, N, &rs, err, sizeof(err)) == 0) {
+      out = (double*)malloc(sizeof(double) * (size_t)N);
+      for (int k = 0; k < N; k++) out[k] = rs.data[k * rs.ncol + c];
+    }
+  }
+  free(times);
+  gs_table_free(&t);
+  gs_table_free(&rs);
+  return out;
 }
 
 // initial guess from the solution folder dir (states.sto, controls.sto); prints the reason
@@ -437,7 +490,10 @@ int gs_cmd_track(int argc, char** argv) {
   cJSON_AddNumberToObject(summary, "max_violation", viol);
   cJSON_AddNumberToObject(summary, "max_defect", max_defect);
   cJSON_AddBoolToObject(summary, "best_iterate_written", zout == zb);
-  if (write_solution(g, zout, o.out, summary) != 0) goto done;
+  double* knee_ref = measured_knee_contact(o.trial, g);
+  int wrote_solution = write_solution(g, zout, o.out, knee_ref, summary);
+  free(knee_ref);
+  if (wrote_solution != 0) goto done;
   char* text = cJSON_Print(summary);
   snprintf(path, sizeof(path), "%s/summary.json", o.out);
   size_t len = text ? strlen(text) : 0;

@@ -18,7 +18,7 @@ static const char* kRunUsage =
     "DIR/track/strip.png. Results in DIR (default\n"
     "results/). Exit status as `gaitsim track` (3: a solve stopped short, its best iterate\n"
     "written).\n\n"
-    "  --max-time S   wall-clock limit of each solve, s (default 900)\n";
+    "  --max-time S   wall-clock limit of each solve, s (default 600)\n";
 
 // run one subcommand with the given words (argv[0] is the subcommand)
 static int sub(gsCommandFn fn, const char* const* words) {
@@ -37,7 +37,7 @@ int gs_cmd_run(int argc, char** argv) {
       {"threads", required_argument, NULL, 't'},  {"max-time", required_argument, NULL, 'T'},
       {"no-video", no_argument, NULL, 'V'},       {"help", no_argument, NULL, 'h'},
       {NULL, 0, NULL, 0}};
-  const char *out = "results", *nodes = "80", *threads = "2", *max_time = "900";
+  const char *out = "results", *nodes = "80", *threads = "2", *max_time = "600";
   int video = 1;
   optind = 1;
   int c;

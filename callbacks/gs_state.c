@@ -117,40 +117,21 @@ int gs_state_map(const mjModel* m, const gsTable* t, gsStateMap* map, char* err,
 }
 
 // column c of t at `time`, linear interpolation, clamped to the time range
-static double value_at(const gsTable* t, int c, double time) {
-  if (t->nrow == 1 || time <= t->time[0]) {
-    return t->data[c];
-  }
-  if (time >= t->time[t->nrow - 1]) {
-    return t->data[(t->nrow - 1) * t->ncol + c];
-  }
-  int lo = 0, hi = t->nrow - 1;
-  while (hi - lo > 1) {
-    int mid = (lo + hi) / 2;
-    if (t->time[mid] <= time) {
-      lo = mid;
-    } else {
-      hi = mid;
-    }
-  }
-  double w = (time - t->time[lo]) / (t->time[hi] - t->time[lo]);
-  return (1 - w) * t->data[lo * t->ncol + c] + w * t->data[hi * t->ncol + c];
-}
 
 void gs_state_apply(const mjModel* m, const gsTable* t, const gsStateMap* map, double time,
                     mjData* d) {
   for (int i = 0; i < m->nq; i++) {
-    if (map->qpos_col[i] >= 0) d->qpos[i] = value_at(t, map->qpos_col[i], time);
+    if (map->qpos_col[i] >= 0) d->qpos[i] = gs_table_value_at(t, map->qpos_col[i], time);
   }
   for (int i = 0; i < m->nv; i++) {
-    if (map->qvel_col[i] >= 0) d->qvel[i] = value_at(t, map->qvel_col[i], time);
+    if (map->qvel_col[i] >= 0) d->qvel[i] = gs_table_value_at(t, map->qvel_col[i], time);
   }
   for (int i = 0; i < m->na; i++) {
-    if (map->act_col[i] >= 0) d->act[i] = value_at(t, map->act_col[i], time);
+    if (map->act_col[i] >= 0) d->act[i] = gs_table_value_at(t, map->act_col[i], time);
   }
   for (int i = 0; i < m->nu; i++) {
-    if (map->fT_col[i] >= 0) d->userdata[i] = value_at(t, map->fT_col[i], time);
-    if (map->ctrl_col[i] >= 0) d->ctrl[i] = value_at(t, map->ctrl_col[i], time);
+    if (map->fT_col[i] >= 0) d->userdata[i] = gs_table_value_at(t, map->fT_col[i], time);
+    if (map->ctrl_col[i] >= 0) d->ctrl[i] = gs_table_value_at(t, map->ctrl_col[i], time);
   }
 }
 

@@ -410,3 +410,23 @@ int gs_table_is_angle_in_list(const char* label, void* user) {
   }
   return 0;
 }
+
+double gs_table_value_at(const gsTable* t, int c, double time) {
+  if (t->nrow == 1 || time <= t->time[0]) {
+    return t->data[c];
+  }
+  if (time >= t->time[t->nrow - 1]) {
+    return t->data[(t->nrow - 1) * t->ncol + c];
+  }
+  int lo = 0, hi = t->nrow - 1;
+  while (hi - lo > 1) {
+    int mid = (lo + hi) / 2;
+    if (t->time[mid] <= time) {
+      lo = mid;
+    } else {
+      hi = mid;
+    }
+  }
+  double w = (time - t->time[lo]) / (t->time[hi] - t->time[lo]);
+  return (1 - w) * t->data[lo * t->ncol + c] + w * t->data[hi * t->ncol + c];
+}

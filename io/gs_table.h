@@ -35,6 +35,10 @@ void gs_table_free(gsTable* t);
 int gs_table_create(gsTable* t, int nrow, int ncol, const char* const* labels, char* err,
                     int errsz);
 
+// Column c of t at `time` (s): linear interpolation between the neighbouring rows (binary
+// search), clamped to the first and last rows outside the table's time range.
+double gs_table_value_at(const gsTable* t, int c, double time);
+
 // Deep copy of src into dst.
 int gs_table_copy(const gsTable* src, gsTable* dst, char* err, int errsz);
 

@@ -17,21 +17,6 @@
 static const double kGrfThreshold = 5.0;  // a foot carries load above this vertical force (N)
 
 // column c of t at `time`, linear interpolation, clamped to the time range
-static double value_at(const gsTable* t, int c, double time) {
-  if (t->nrow == 1 || time <= t->time[0]) return t->data[c];
-  if (time >= t->time[t->nrow - 1]) return t->data[(t->nrow - 1) * t->ncol + c];
-  int lo = 0, hi = t->nrow - 1;
-  while (hi - lo > 1) {
-    int mid = (lo + hi) / 2;
-    if (t->time[mid] <= time) {
-      lo = mid;
-    } else {
-      hi = mid;
-    }
-  }
-  double w = (time - t->time[lo]) / (t->time[hi] - t->time[lo]);
-  return (1 - w) * t->data[lo * t->ncol + c] + w * t->data[hi * t->ncol + c];
-}
 
 // read path into t (angles to radians for model m); a missing file is an error naming it
 static int read_table(const mjModel* m, const char* path, gsTable* t, char* err, int errsz) {
@@ -79,7 +64,7 @@ static int setup_states(const mjModel* m, grMotion* mo, const char* path, char* 
   mo->advance_qpos = (j >= 0 && m->jnt_type[j] == mjJNT_SLIDE) ? m->jnt_qposadr[j] : -1;
   if (mo->advance_qpos >= 0 && mo->smap.qpos_col[mo->advance_qpos] >= 0) {
     int c = mo->smap.qpos_col[mo->advance_qpos];
-    mo->advance = value_at(&mo->states, c, mo->t1) - value_at(&mo->states, c, mo->t0);
+    mo->advance = gs_table_value_at(&mo->states, c, mo->t1) - gs_table_value_at(&mo->states, c, mo->t0);
   }
   mo->body_weight = mj_getTotalmass(m) * mju_norm3(m->opt.gravity);
   if (mo->body_weight <= 0) mo->body_weight = 1;
@@ -233,8 +218,8 @@ void gr_motion_apply(const mjModel* m, const grMotion* mo, double t, mjData* d,
     for (int f = 0; f < 2; f++) {
       double v[3], p[3];
       for (int k = 0; k < 3; k++) {
-        v[k] = value_at(&mo->grf, mo->foot[f].force[k], ts);
-        p[k] = value_at(&mo->grf, mo->foot[f].cop[k], ts);
+        v[k] = gs_table_value_at(&mo->grf, mo->foot[f].force[k], ts);
+        p[k] = gs_table_value_at(&mo->grf, mo->foot[f].cop[k], ts);
       }
       out->grf[f][0] = v[0];
       out->grf[f][1] = -v[2];
@@ -247,7 +232,7 @@ void gr_motion_apply(const mjModel* m, const grMotion* mo, double t, mjData* d,
   }
   for (int f = 0; f < 2; f++) {
     if (mo->knee_col[f] >= 0) {
-      out->knee[f] = value_at(&mo->knee, mo->knee_col[f], ts);
+      out->knee[f] = gs_table_value_at(&mo->knee, mo->knee_col[f], ts);
       out->knee_on[f] = 1;
     }
   }

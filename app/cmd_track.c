@@ -19,6 +19,7 @@
 #include "io/gs_storage.h"
 #include "optim/go_gait.h"
 #include "optim/go_gait_guess.h"
+#include "optim/go_hessian.h"
 #include "optim/go_ipopt.h"
 #include "optim/go_jacobian.h"
 
@@ -36,8 +37,9 @@ static const char* kTrackUsage =
     "  --max-iter N        Ipopt iteration limit (default 1000)\n"
     "  --max-time S        wall-clock limit, s (default none)\n"
     "  --activation A      initial activations and excitations (default 0.05)\n"
-    "  --hessian H         lbfgs (default: Ipopt's limited-memory quasi-Newton) or gauss-newton\n"
-    "                      (exact for the tracking squares, constraint curvature left out)\n"
+    "  --hessian H         lbfgs (default: Ipopt's limited-memory quasi-Newton), pqn\n"
+    "                      (partitioned quasi-Newton, SR1 per node element; experimental) or\n"
+    "                      gauss-newton (exact for the tracking squares, constraints left out)\n"
     "  --weight NAME=W     goal weight, NAME one of pelvis_rot (default 10), pelvis_trans (10),\n"
     "                      joint (1), grf (10), effort (0.1) (repeatable); each tracking group is\n"
     "                      a mean of squared errors over 5 deg, 2 cm or 0.1 BW\n"
@@ -55,6 +57,7 @@ typedef struct {
   double activation;   // initial activation (-)
   go_ipopt_opts ipopt; // solver options
   double w_pelvis_rot, w_pelvis_trans, w_joint, w_grf, w_effort;  // goal weights (-)
+  int pqn;             // 1: partitioned quasi-Newton Hessian (go_hessian.h)
 } gsTrackOptions;
 
 // --weight NAME=VALUE
@@ -101,6 +104,7 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
   o->activation = 0.05;
   go_ipopt_opts_default(&o->ipopt);
   o->ipopt.gauss_newton = 0;
+  o->pqn = 0;
   // stopping rule (overridable with --ipopt): feasible to 1e-6 (scaled) and the objective
   // settled to 1e-4 relative over 15 iterations, or Ipopt's own optimality at tol 1e-4
   static const char* stop_rule[][2] = {
@@ -144,9 +148,9 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
         }
         break;
       case 'H':
-        if (strcmp(optarg, "gauss-newton") == 0) o->ipopt.gauss_newton = 1;
-        else if (strcmp(optarg, "lbfgs") == 0) o->ipopt.gauss_newton = 0;
-        else return -1;
+        o->pqn = strcmp(optarg, "pqn") == 0;
+        o->ipopt.gauss_newton = strcmp(optarg, "gauss-newton") == 0;
+        if (!o->pqn && !o->ipopt.gauss_newton && strcmp(optarg, "lbfgs") != 0) return -1;
         break;
       case 'w':
         if (parse_weight(optarg, o)) return -1;
@@ -400,6 +404,7 @@ int gs_cmd_track(int argc, char** argv) {
   gs_table_init(&coords);
   gs_table_init(&grf);
   go_gait* g = NULL;
+  go_hess* hess = NULL;
   double *z = NULL, *zb = NULL, *zs = NULL, *gv = NULL;
   cJSON* summary = NULL;
   char path[4096], err[1024];
@@ -460,6 +465,11 @@ int gs_cmd_track(int argc, char** argv) {
   o.ipopt.max_wall_s = o.max_time;
   o.ipopt.progress = stderr;
   o.ipopt.handle_sigint = 1;
+  if (o.pqn && go_hess_create(&hess, nlp, go_gait_elements(g), err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: track: %s\n", err);
+    goto done;
+  }
+  o.ipopt.hess = hess;
   go_solve_result res;
   if (go_ipopt_solve(nlp, &o.ipopt, z, zb, NULL, &res, err, sizeof(err)) != 0) {
     fprintf(stderr, "gaitsim: track: %s\n", err);
@@ -510,6 +520,7 @@ int gs_cmd_track(int argc, char** argv) {
 done:
   cJSON_Delete(summary);
   free(z), free(zb), free(zs), free(gv);
+  go_hess_free(hess);
   go_gait_free(g);
   gs_table_free(&coords);
   gs_table_free(&grf);

@@ -66,6 +66,8 @@ struct go_gait {
   double w_effort;            // effort weight / na
   int* ivars;                 // integrand variables
   int n_ivars;
+  go_elements el;             // Hessian elements of a node (go_gait_elements)
+  int* el_mem;                // their arrays, one allocation
   gait_ctx* ctx;              // (nthreads)
   void** ctx_ptr;             // (nthreads)
   int nthreads;
@@ -476,9 +478,64 @@ void go_gait_free(go_gait* g) {
   free(g->tree), free(g->foot), free(g->col_ptr), free(g->row_idx), free(g->analytic);
   free(g->z_lb), free(g->z_ub), free(g->z_scale), free(g->path_scale), free(g->bnd_var);
   free(g->bnd_col_ptr), free(g->bnd_row_idx), free(g->bnd_scale), free(g->q_ref);
-  free(g->grf_ref), free(g->q_wt), free(g->ivars);
+  free(g->grf_ref), free(g->q_wt), free(g->ivars), free(g->el_mem);
   free(g);
 }
+
+// Hessian elements of a node (go_hessian.h), variables in increasing node-variable order:
+//   dynamics      eom and grf rows over q, qdot, a (rigid muscles), fT, qddot
+//   tendon e      hill row e over q and qdot of the dofs muscle i crosses, a_i, fT_e, fT'_e
+//   activation i  act row i over a_i, e_i
+// (link rows are linear; the grf variables, q' and adot enter linearly).
+static int build_elements(go_gait* g) {
+  const go_gait_layout* L = &g->L;
+  int nv = L->nv, na = L->na, ne = L->ne, E = 1 + ne + na;
+  int nrows = 2 * nv + 2 * 0 + nv + GO_GAIT_NGRF + ne + na;  // generous
+  int nvars = (3 * nv + na + ne) + ne * (2 * nv + 3) + 2 * na;
+  int* mem = (int*)malloc(sizeof(int) * (size_t)(2 * (E + 1) + nrows + nvars));
+  if (!mem) return -1;
+  int *row_ptr = mem, *var_ptr = mem + E + 1, *rows = var_ptr + E + 1, *vars = rows + nrows;
+  int nr = 0, nvv = 0, e = 0;
+  // dynamics
+  row_ptr[0] = var_ptr[0] = 0;
+  for (int j = 0; j < nv; j++) rows[nr++] = L->r_eom + j;
+  for (int c = 0; c < GO_GAIT_NGRF; c++) rows[nr++] = L->r_grf + c;
+  for (int j = 0; j < nv; j++) vars[nvv++] = L->x_q + j;
+  for (int j = 0; j < nv; j++) vars[nvv++] = L->x_qd + j;
+  for (int i = 0; i < na; i++)
+    if (L->elastic_of[i] < 0) vars[nvv++] = L->x_a + i;
+  for (int t = 0; t < ne; t++) vars[nvv++] = L->x_ft + t;
+  for (int j = 0; j < nv; j++) vars[nvv++] = L->xd_qdd + j;
+  row_ptr[++e] = nr;
+  var_ptr[e] = nvv;
+  // tendons
+  for (int t = 0; t < ne; t++) {
+    int i = L->elastic[t];
+    rows[nr++] = L->r_hill + t;
+    for (int j = 0; j < nv; j++)
+      if (g->cross[i * nv + j]) vars[nvv++] = L->x_q + j;
+    for (int j = 0; j < nv; j++)
+      if (g->cross[i * nv + j]) vars[nvv++] = L->x_qd + j;
+    vars[nvv++] = L->x_a + i;
+    vars[nvv++] = L->x_ft + t;
+    vars[nvv++] = L->xd_ft + t;
+    row_ptr[++e] = nr;
+    var_ptr[e] = nvv;
+  }
+  // activations
+  for (int i = 0; i < na; i++) {
+    rows[nr++] = L->r_act + i;
+    vars[nvv++] = L->x_a + i;
+    vars[nvv++] = L->u_e + i;
+    row_ptr[++e] = nr;
+    var_ptr[e] = nvv;
+  }
+  g->el_mem = mem;
+  g->el = (go_elements){E, row_ptr, rows, var_ptr, vars};
+  return 0;
+}
+
+const go_elements* go_gait_elements(const go_gait* g) { return &g->el; }
 
 // coordinate column of each dof in t (-1: absent)
 static void coord_columns(const mjModel* m, const gsTable* t, int* col) {
@@ -855,6 +912,11 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   p.thread_ctx = g->ctx_ptr;
   p.nthreads = g->nthreads;
   if (go_nlp_create(&g->nlp, &p, err, errsz) != 0) {
+    go_gait_free(g);
+    return -1;
+  }
+  if (build_elements(g) != 0) {
+    snprintf(err, (size_t)errsz, "go_gait: out of memory (Hessian elements)");
     go_gait_free(g);
     return -1;
   }

@@ -62,6 +62,7 @@
 
 #include "io/gs_table.h"
 #include "optim/go_collocation.h"
+#include "optim/go_hessian.h"
 
 #define GO_GAIT_NGRF 6  // grf variables per node: right foot x y z, left foot x y z (world)
 
@@ -125,6 +126,10 @@ double go_gait_weight(const go_gait* g);   // body weight m g (N)
 
 // 1 if dof j belongs to the root body (the pelvis: the body of the tree's first dof), else 0.
 int go_gait_dof_is_root(const mjModel* m, int j);
+
+// Hessian elements of one node for the partitioned quasi-Newton Hessian (go_hessian.h): the
+// dynamics (eom and grf rows), one per elastic tendon (hill row), one per muscle (activation row).
+const go_elements* go_gait_elements(const go_gait* g);
 
 // Measured coordinate at node k, dof j (physical), or NAN when not measured.
 double go_gait_q_ref(const go_gait* g, int k, int j);

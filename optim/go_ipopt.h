@@ -39,6 +39,9 @@ typedef struct {
   int gauss_newton;       // 1: Ipopt's exact-Hessian mode with the Gauss-Newton Hessian
                           // (go_nlp_eval_hess_diag; the problem needs integrand_hess);
                           // 0: limited-memory quasi-Newton (L-BFGS)
+  struct go_hess* hess;   // non-NULL: Ipopt's exact-Hessian mode with this partitioned
+                          // quasi-Newton Hessian (go_hessian.h; takes precedence over
+                          // gauss_newton); not owned
   int n_kv;               // extra Ipopt options, applied after all of the above, in order
   go_ipopt_kv kv[GO_IPOPT_MAX_OPTIONS];
 } go_ipopt_opts;

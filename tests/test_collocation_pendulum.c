@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "optim/go_collocation.h"
+#include "optim/go_hessian.h"
 #include "optim/go_ipopt.h"
 #include "tests/gs_test.h"
 
@@ -22,6 +23,11 @@ static int integrand(void* ctx, int k, const double* z, double* L) {
   return 0;
 }
 static const int ivars[1] = {4};
+static int integrand_hess(void* ctx, int k, const double* z, double* d2L) {
+  memset(d2L, 0, 5 * sizeof(double));
+  d2L[4] = 2.0;
+  return 0;
+}
 
 // run go_ipopt_solve with fd 1 sent to a file; returns the bytes written to stdout
 static long solve_quiet(go_nlp* nlp, go_ipopt_opts* o, double* z, double* zb, go_solve_result* r,
@@ -135,7 +141,9 @@ static int pe_boundary(void* ctx, const double* z0, const double* z1, double T, 
 static const int pe_bcol[12] = {0, 0, 0, 0, 0, 0, 1, 2, 2, 2, 2, 2};
 static const int pe_brow[2] = {0, 1};
 
-static void test_swing_up(void) {
+// swing-up with Ipopt's L-BFGS (pqn = 0) or the partitioned quasi-Newton Hessian (pqn = 1, one
+// element: the dynamics row omega' + g sin(theta) - u over theta); returns the iterations
+static int test_swing_up(int pqn) {
   enum { N = 51, NZ = 5 };
   go_bound_override ov[2] = {{0, 0, 0.0, 0.0}, {0, 1, 0.0, 0.0}};
   double lb[NZ] = {-10, -30, -30, -200, -50}, ub[NZ] = {10, 30, 30, 200, 50};
@@ -162,10 +170,15 @@ static void test_swing_up(void) {
   p.bnd_row_idx = pe_brow;
   p.thread_ctx = ctx;
   p.nthreads = 2;
+  if (pqn) p.integrand_hess = integrand_hess;
   go_nlp* nlp = NULL;
   char err[256];
   EXPECT_EQ_INT(0, go_nlp_create(&nlp, &p, err, sizeof(err)));
-  if (!nlp) return;
+  if (!nlp) return -1;
+  static const int el_rows[1] = {1}, el_vars[1] = {0}, el_ptr[2] = {0, 1};
+  go_elements el = {1, el_ptr, el_rows, el_ptr, el_vars};
+  go_hess* hess = NULL;
+  if (pqn) EXPECT_EQ_INT(0, go_hess_create(&hess, nlp, &el, err, sizeof(err)));
   double z[N * NZ];
   for (int k = 0; k < N; k++) {
     double t = 2.0 * k / (N - 1);
@@ -175,6 +188,7 @@ static void test_swing_up(void) {
   go_ipopt_opts o;
   go_ipopt_opts_default(&o);
   o.tol = 1e-9;
+  o.hess = hess;
   EXPECT_EQ_INT(0, go_ipopt_opts_add(&o, "constr_viol_tol=1e-10", err, sizeof(err)));
   go_solve_result r;
   int rc;
@@ -187,15 +201,21 @@ static void test_swing_up(void) {
   EXPECT_NEAR(0.0, z[0], 1e-12);
   go_eval_counts c;
   go_nlp_counts(nlp, &c);
-  printf("swing-up: %s, %d iterations, J = %.6f, theta_end - pi = %.2e, omega_end = %.2e, "
+  printf("swing-up (%s): %s, %d iterations, J = %.6f, theta_end - pi = %.2e, omega_end = %.2e, "
          "%.3f s, %ld path evaluations (%ld per Jacobian), %ld Jacobians\n",
-         go_solve_status_str(r.status), r.iterations, r.objective, z[(N - 1) * NZ] - M_PI,
-         z[(N - 1) * NZ + 1], r.wall_s, c.path_evals, c.path_evals_last_jac, c.jac_evals);
+         pqn ? "partitioned quasi-Newton" : "L-BFGS", go_solve_status_str(r.status), r.iterations,
+         r.objective, z[(N - 1) * NZ] - M_PI, z[(N - 1) * NZ + 1], r.wall_s, c.path_evals,
+         c.path_evals_last_jac, c.jac_evals);
+  go_hess_free(hess);
   go_nlp_free(nlp);
+  return r.iterations;
 }
 
 int main(void) {
   test_double_integrator();
-  test_swing_up();
+  int it_lbfgs = test_swing_up(0);
+  int it_pqn = test_swing_up(1);
+  // the element Hessian learns the one nonlinear term; it must not need more iterations
+  EXPECT_TRUE(it_pqn > 0 && it_pqn <= it_lbfgs);
   return GS_TEST_RESULT();
 }

@@ -43,6 +43,9 @@ static const char* kTrackUsage =
     "  --weight NAME=W     goal weight, NAME one of pelvis_rot (default 10), pelvis_trans (10),\n"
     "                      joint (1), grf (10), effort (0.1) (repeatable); each tracking group is\n"
     "                      a mean of squared errors over 5 deg, 2 cm or 0.1 BW\n"
+    "  --no-polish         no feasibility polish (by default a solve that stops short is\n"
+    "                      followed by a Gauss-Newton projection of its best iterate onto the\n"
+    "                      dynamics: the nearest dynamically consistent point)\n"
     "  --ipopt KEY=VALUE   extra Ipopt option (repeatable)\n";
 
 typedef struct {
@@ -58,6 +61,7 @@ typedef struct {
   go_ipopt_opts ipopt; // solver options
   double w_pelvis_rot, w_pelvis_trans, w_joint, w_grf, w_effort;  // goal weights (-)
   int pqn;             // 1: partitioned quasi-Newton Hessian (go_hessian.h)
+  int polish;          // 1: feasibility polish after a solve that stopped short
 } gsTrackOptions;
 
 // --weight NAME=VALUE
@@ -94,7 +98,7 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
       {"max-iter", required_argument, NULL, 'i'}, {"max-time", required_argument, NULL, 'T'},
       {"activation", required_argument, NULL, 'a'}, {"ipopt", required_argument, NULL, 'p'},
       {"hessian", required_argument, NULL, 'H'},  {"weight", required_argument, NULL, 'w'},
-      {"init", required_argument, NULL, 'I'},
+      {"init", required_argument, NULL, 'I'},     {"no-polish", no_argument, NULL, 'P'},
       {"help", no_argument, NULL, 'h'},           {NULL, 0, NULL, 0}};
   memset(o, 0, sizeof(*o));
   o->model = GS_DEFAULT_MODEL;
@@ -105,6 +109,7 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
   go_ipopt_opts_default(&o->ipopt);
   o->ipopt.gauss_newton = 0;
   o->pqn = 0;
+  o->polish = 1;
   // stopping rule (overridable with --ipopt): feasible to 1e-6 (scaled) and the objective
   // settled to 1e-4 relative over 15 iterations, or Ipopt's own optimality at tol 1e-4
   static const char* stop_rule[][2] = {
@@ -120,7 +125,7 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
   optind = 1;
   int c;
   char *end;
-  while ((c = getopt_long(argc, argv, "o:m:n:t:i:T:a:p:H:w:I:h", options, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, "o:m:n:t:i:T:a:p:H:w:I:Ph", options, NULL)) != -1) {
     switch (c) {
       case 'o': o->out = optarg; break;
       case 'm': o->model = optarg; break;
@@ -156,6 +161,7 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
         if (parse_weight(optarg, o)) return -1;
         break;
       case 'I': o->init = optarg; break;
+      case 'P': o->polish = 0; break;
       case 'h': fputs(kTrackUsage, stdout); exit(GS_EXIT_OK);
       default: return -1;
     }
@@ -211,7 +217,8 @@ static double knee_contact_total(const mjModel* m, const mjData* d) {
 }
 
 // write the solution tables and accumulate the RMS errors into summary; knee_ref: measured
-// total knee contact force (N) at the nodes, or NULL
+// total knee contact force (N) at the nodes, or NULL; knee_contact.sto only for a model with the
+// right knee's knee_ty joint
 static int write_solution(go_gait* g, const double* z, const char* out, const double* knee_ref,
                           cJSON* summary) {
   const mjModel* m = go_gait_model(g);
@@ -297,7 +304,7 @@ static int write_solution(go_gait* g, const double* z, const char* out, const do
       gs_app_write_table(out, "controls.sto", &controls) == 0 &&
       gs_app_write_table(out, "grf.mot", &grf) == 0 &&
       gs_app_write_table(out, "muscle_forces.sto", &forces) == 0 &&
-      gs_app_write_table(out, "knee_contact.sto", &knee) == 0) {
+      (!isfinite(knee.data[0]) || gs_app_write_table(out, "knee_contact.sto", &knee) == 0)) {
     status = 0;
   }
 done:
@@ -427,12 +434,13 @@ int gs_cmd_track(int argc, char** argv) {
   }
   go_gait_opts go;
   go_gait_opts_default(&go);
-  static const char* free_coords[] = {"pelvis_tz", NULL};  // the trial drifts sideways
+  // the trial drifts sideways: pelvis_tz is not periodic (when the model has it)
+  static const char* free_coords[] = {"pelvis_tz", NULL};
   go.N = o.nodes;
   go.nthreads = o.threads;
   go.coords = &coords;
   go.grf = &grf;
-  go.free_coords = free_coords;
+  go.free_coords = mj_name2id(m, mjOBJ_JOINT, "pelvis_tz") >= 0 ? free_coords : NULL;
   go.w_pelvis_rot = o.w_pelvis_rot;
   go.w_pelvis_trans = o.w_pelvis_trans;
   go.w_joint = o.w_joint;
@@ -476,8 +484,50 @@ int gs_cmd_track(int argc, char** argv) {
     goto done;
   }
   int converged = res.status == GO_SOLVE_SUCCESS || res.status == GO_SOLVE_ACCEPTABLE;
-  const double* zout = converged || res.best_iter < 0 ? z : zb;
+  double* zout = converged || res.best_iter < 0 ? z : zb;
+  // feasibility polish when the tracking solve stopped short: the dynamically consistent point
+  // nearest to its best iterate (go_gait_set_proximal), by Gauss-Newton
+  go_solve_result pres;
+  int polished = 0;
+  double viol_before = converged ? res.max_viol : res.best_viol;
+  if (!converged && o.polish && res.best_iter >= 0 && viol_before > 1e-8) {
+    if (go_gait_set_proximal(g, zout) != 0) {
+      fprintf(stderr, "gaitsim: track: out of memory (polish)\n");
+      goto done;
+    }
+    memcpy(z, zout, sizeof(double) * (size_t)n);
+    go_ipopt_opts po;
+    go_ipopt_opts_default(&po);
+    po.gauss_newton = 1;
+    po.max_iter = 200;
+    po.max_wall_s = o.max_time;
+    po.progress = stderr;
+    po.handle_sigint = 1;
+    go_ipopt_opts_set(&po, "tol", "1e-6", err, sizeof(err));
+    go_ipopt_opts_set(&po, "constr_viol_tol", "1e-8", err, sizeof(err));
+    // start at the best iterate itself: a small barrier, the point barely pushed off its bounds
+    go_ipopt_opts_set(&po, "mu_init", "1e-6", err, sizeof(err));
+    go_ipopt_opts_set(&po, "bound_push", "1e-8", err, sizeof(err));
+    go_ipopt_opts_set(&po, "bound_frac", "1e-8", err, sizeof(err));
+    fprintf(stderr, "track: feasibility polish from violation %.3g\n", viol_before);
+    int prc = go_ipopt_solve(nlp, &po, z, zs, NULL, &pres, err, sizeof(err));
+    go_gait_set_proximal(g, NULL);
+    if (prc != 0) {
+      fprintf(stderr, "gaitsim: track: polish: %s\n", err);
+      goto done;
+    }
+    int pconv = pres.status == GO_SOLVE_SUCCESS || pres.status == GO_SOLVE_ACCEPTABLE;
+    const double* zp = pconv || pres.best_iter < 0 ? z : zs;
+    double vp = pconv || pres.best_iter < 0 ? pres.max_viol : pres.best_viol;
+    if (vp < viol_before) {
+      memcpy(zb, zp, sizeof(double) * (size_t)n);
+      zout = zb;
+      polished = 1;
+    }
+  }
   go_nlp_scale_z(nlp, zout, zs);
+  double fout;
+  double obj_out = go_nlp_eval_f(nlp, zs, &fout) == 0 ? go_nlp_objective_phys(nlp, fout) : NAN;
   double viol = go_nlp_eval_g(nlp, zs, gv) == 0 ? go_nlp_violation(nlp, gv) : INFINITY;
   print_blocks(g, gv, "final");
   double max_defect = 0;
@@ -495,7 +545,15 @@ int gs_cmd_track(int argc, char** argv) {
   cJSON_AddNumberToObject(summary, "threads", o.threads);
   cJSON_AddNumberToObject(summary, "stride_time_s", go_gait_stride_time(g));
   cJSON_AddNumberToObject(summary, "grf_scale", grf_scale);
-  cJSON_AddNumberToObject(summary, "objective", zout == z ? res.objective : res.best_objective);
+  cJSON_AddNumberToObject(summary, "objective", obj_out);
+  if (polished || (!converged && o.polish && res.best_iter >= 0 && viol_before > 1e-8)) {
+    cJSON* pj = cJSON_AddObjectToObject(summary, "polish");
+    cJSON_AddStringToObject(pj, "status", go_solve_status_str(pres.status));
+    cJSON_AddNumberToObject(pj, "iterations", pres.iterations);
+    cJSON_AddNumberToObject(pj, "wall_s", pres.wall_s);
+    cJSON_AddNumberToObject(pj, "violation_before", viol_before);
+    cJSON_AddBoolToObject(pj, "used", polished);
+  }
   cJSON_AddNumberToObject(summary, "initial_violation", viol0);
   cJSON_AddNumberToObject(summary, "max_violation", viol);
   cJSON_AddNumberToObject(summary, "max_defect", max_defect);

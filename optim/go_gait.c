@@ -66,6 +66,8 @@ struct go_gait {
   double w_effort;            // effort weight / na
   int* ivars;                 // integrand variables
   int n_ivars;
+  double* prox_z0;            // proximal target z0 (N nz, physical) while polishing, else NULL
+  double* prox_w;             // proximal weights 1 / z_scale^2 (nz)
   go_elements el;             // Hessian elements of a node (go_gait_elements)
   int* el_mem;                // their arrays, one allocation
   gait_ctx* ctx;              // (nthreads)
@@ -266,9 +268,26 @@ static int path_jac_cb(void* vctx, int k, const double* z, double* vals) {
 
 // --- objective --------------------------------------------------------------------------------
 
+// proximal integrand of the feasibility polish: sum_j ((z_j - z0_kj) / z_scale_j)^2
+static double proximal(const go_gait* g, int k, const double* z, double* dL, double* d2L) {
+  const double* z0 = g->prox_z0 + (size_t)k * g->L.nz;
+  double s = 0;
+  for (int j = 0; j < g->L.nz; j++) {
+    double e = z[j] - z0[j];
+    s += g->prox_w[j] * e * e;
+    if (dL) dL[j] = 2 * g->prox_w[j] * e;
+    if (d2L) d2L[j] = 2 * g->prox_w[j];
+  }
+  return s;
+}
+
 static int integrand_cb(void* vctx, int k, const double* z, double* out) {
   const go_gait* g = ((gait_ctx*)vctx)->g;
   const go_gait_layout* L = &g->L;
+  if (g->prox_z0) {
+    *out = proximal(g, k, z, NULL, NULL);
+    return isfinite(*out) ? 0 : -1;
+  }
   double s = 0;
   for (int j = 0; j < L->nv; j++) {
     if (g->q_wt[j] > 0) {
@@ -292,6 +311,10 @@ static int integrand_cb(void* vctx, int k, const double* z, double* out) {
 static int integrand_grad_cb(void* vctx, int k, const double* z, double* dL) {
   const go_gait* g = ((gait_ctx*)vctx)->g;
   const go_gait_layout* L = &g->L;
+  if (g->prox_z0) {
+    proximal(g, k, z, dL, NULL);
+    return 0;
+  }
   memset(dL, 0, sizeof(double) * (size_t)L->nz);
   for (int j = 0; j < L->nv; j++) {
     if (g->q_wt[j] > 0) {
@@ -313,6 +336,10 @@ static int integrand_grad_cb(void* vctx, int k, const double* z, double* dL) {
 static int integrand_hess_cb(void* vctx, int k, const double* z, double* d2L) {
   const go_gait* g = ((gait_ctx*)vctx)->g;
   const go_gait_layout* L = &g->L;
+  if (g->prox_z0) {
+    proximal(g, k, z, NULL, d2L);
+    return 0;
+  }
   memset(d2L, 0, sizeof(double) * (size_t)L->nz);
   for (int j = 0; j < L->nv; j++) d2L[L->x_q + j] = 2 * g->q_wt[j];
   for (int c = 0; c < GO_GAIT_NGRF; c++) d2L[L->u_grf + c] = 2 * g->w_grf;
@@ -478,7 +505,8 @@ void go_gait_free(go_gait* g) {
   free(g->tree), free(g->foot), free(g->col_ptr), free(g->row_idx), free(g->analytic);
   free(g->z_lb), free(g->z_ub), free(g->z_scale), free(g->path_scale), free(g->bnd_var);
   free(g->bnd_col_ptr), free(g->bnd_row_idx), free(g->bnd_scale), free(g->q_ref);
-  free(g->grf_ref), free(g->q_wt), free(g->ivars), free(g->el_mem);
+  free(g->grf_ref), free(g->q_wt), free(g->ivars), free(g->el_mem), free(g->prox_z0);
+  free(g->prox_w);
   free(g);
 }
 
@@ -536,6 +564,21 @@ static int build_elements(go_gait* g) {
 }
 
 const go_elements* go_gait_elements(const go_gait* g) { return &g->el; }
+
+int go_gait_set_proximal(go_gait* g, const double* z0) {
+  int n = g->N * g->L.nz;
+  if (!z0) {
+    free(g->prox_z0);
+    g->prox_z0 = NULL;
+    return 0;
+  }
+  if (!g->prox_z0) g->prox_z0 = (double*)malloc(sizeof(double) * (size_t)n);
+  if (!g->prox_w) g->prox_w = (double*)malloc(sizeof(double) * (size_t)g->L.nz);
+  if (!g->prox_z0 || !g->prox_w) return -1;
+  memcpy(g->prox_z0, z0, sizeof(double) * (size_t)n);
+  for (int j = 0; j < g->L.nz; j++) g->prox_w[j] = 1.0 / (g->z_scale[j] * g->z_scale[j]);
+  return 0;
+}
 
 // coordinate column of each dof in t (-1: absent)
 static void coord_columns(const mjModel* m, const gsTable* t, int* col) {

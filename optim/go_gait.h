@@ -131,6 +131,14 @@ int go_gait_dof_is_root(const mjModel* m, int j);
 // dynamics (eom and grf rows), one per elastic tendon (hill row), one per muscle (activation row).
 const go_elements* go_gait_elements(const go_gait* g);
 
+// Feasibility polish: with z0 (N nz, physical; copied) the objective becomes the proximal term
+// sum_k w_k h sum_j ((z_kj - z0_kj) / z_scale_j)^2 / T instead of the tracking goals, so a solve
+// (best with the Gauss-Newton Hessian, exact for this objective, go_ipopt_opts.gauss_newton)
+// finds the dynamically consistent point nearest to z0; its multipliers are of the order of z0's
+// violation, so the missing constraint curvature hardly matters. z0 NULL restores the tracking
+// goals. 0, or -1 when out of memory.
+int go_gait_set_proximal(go_gait* g, const double* z0);
+
 // Measured coordinate at node k, dof j (physical), or NAN when not measured.
 double go_gait_q_ref(const go_gait* g, int k, int j);
 // Measured ground reaction at node k, component c (world, N, GO_GAIT_NGRF), or NAN.

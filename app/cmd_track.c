@@ -62,6 +62,9 @@ typedef struct {
   double w_pelvis_rot, w_pelvis_trans, w_joint, w_grf, w_effort;  // goal weights (-)
   int pqn;             // 1: partitioned quasi-Newton Hessian (go_hessian.h)
   int polish;          // 1: feasibility polish after a solve that stopped short
+  int predict;         // 1: the predictive problem (gaitsim predict)
+  const char* guess;   // predict: solution folder to start from (the tracking solution)
+  double speed;        // predict: prescribed mean speed (m/s)
 } gsTrackOptions;
 
 // --weight NAME=VALUE
@@ -90,16 +93,9 @@ static int parse_int(const char* s, int lo, int* v) {
   return 0;
 }
 
-static int parse(int argc, char** argv, gsTrackOptions* o) {
+// the defaults of every option (tracking; gaitsim predict changes a few)
+static void defaults(gsTrackOptions* o) {
   char err[256];
-  static const struct option options[] = {
-      {"out", required_argument, NULL, 'o'},      {"model", required_argument, NULL, 'm'},
-      {"nodes", required_argument, NULL, 'n'},    {"threads", required_argument, NULL, 't'},
-      {"max-iter", required_argument, NULL, 'i'}, {"max-time", required_argument, NULL, 'T'},
-      {"activation", required_argument, NULL, 'a'}, {"ipopt", required_argument, NULL, 'p'},
-      {"hessian", required_argument, NULL, 'H'},  {"weight", required_argument, NULL, 'w'},
-      {"init", required_argument, NULL, 'I'},     {"no-polish", no_argument, NULL, 'P'},
-      {"help", no_argument, NULL, 'h'},           {NULL, 0, NULL, 0}};
   memset(o, 0, sizeof(*o));
   o->model = GS_DEFAULT_MODEL;
   o->nodes = 80;
@@ -122,6 +118,19 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
   o->w_pelvis_rot = o->w_pelvis_trans = o->w_grf = 10.0;
   o->w_joint = 1.0;
   o->w_effort = 0.1;
+}
+
+static int parse(int argc, char** argv, gsTrackOptions* o) {
+  char err[256];
+  static const struct option options[] = {
+      {"out", required_argument, NULL, 'o'},      {"model", required_argument, NULL, 'm'},
+      {"nodes", required_argument, NULL, 'n'},    {"threads", required_argument, NULL, 't'},
+      {"max-iter", required_argument, NULL, 'i'}, {"max-time", required_argument, NULL, 'T'},
+      {"activation", required_argument, NULL, 'a'}, {"ipopt", required_argument, NULL, 'p'},
+      {"hessian", required_argument, NULL, 'H'},  {"weight", required_argument, NULL, 'w'},
+      {"init", required_argument, NULL, 'I'},     {"no-polish", no_argument, NULL, 'P'},
+      {"help", no_argument, NULL, 'h'},           {NULL, 0, NULL, 0}};
+  defaults(o);
   optind = 1;
   int c;
   char *end;
@@ -224,7 +233,7 @@ static int write_solution(go_gait* g, const double* z, const char* out, const do
   const mjModel* m = go_gait_model(g);
   const go_gait_layout* L = go_gait_layout_get(g);
   int N = go_gait_nodes(g), nv = L->nv, na = L->na, status = -1;
-  double T = go_gait_stride_time(g), bw = go_gait_weight(g);
+  double T = go_gait_time_of(g, z), bw = go_gait_weight(g);
   mjData* d = mj_makeData(m);
   gsTable states, controls, grf, forces, knee;
   gs_table_init(&knee);
@@ -344,7 +353,7 @@ static void print_blocks(go_gait* g, const double* gv, const char* when) {
       at[blk] = blk == 0 ? r % L->nx : blk < 6 ? (r - p0) % L->n_path : r - b0;
     }
   }
-  fprintf(stderr, "track: %s violation by block:", when);
+  fprintf(stderr, "%s violation by block:", when);
   for (int b = 0; b < 7; b++) fprintf(stderr, " %s %.3g (#%d)", names[b], mx[b], at[b]);
   fprintf(stderr, "\n");
 }
@@ -398,12 +407,204 @@ done:
   return rc;
 }
 
+static int solve(gsTrackOptions o);
+
+// Predictive problem set-up (Lin, Walter & Pandy 2018, eqs. 1-3): the guess from o->guess at the
+// node times (band, N nz + 1 + 2 nv doubles: node variables, T, then the half-widths of the q and
+// qdot bands), cost of transport with free stride time and the mean speed, the band of eq. 3
+// around the guess: PREDICT_BAND_ROT rad / PREDICT_BAND_TRANS m, PREDICT_BAND_ROT_SPEED rad/s /
+// PREDICT_BAND_TRANS_SPEED m/s (pelvis_tx itself unbounded). Prints the reason on failure.
+#define PREDICT_BAND_ROT 0.35         // rad (20 deg)
+#define PREDICT_BAND_TRANS 0.05       // m
+#define PREDICT_BAND_ROT_SPEED 6.0    // rad/s
+#define PREDICT_BAND_TRANS_SPEED 1.0  // m/s
+static int predict_setup(const mjModel* m, gsTrackOptions* o, go_gait_opts* go, double** band,
+                         double* T0, double* dx0) {
+  gsTable states, controls;
+  gs_table_init(&states);
+  gs_table_init(&controls);
+  go_gait* tmp = NULL;
+  char path[4096], err[512];
+  int rc = -1, nv = m->nv;
+  snprintf(path, sizeof(path), "%s/states.sto", o->guess);
+  if (gs_app_read_table(m, path, &states) != 0) goto done;
+  snprintf(path, sizeof(path), "%s/controls.sto", o->guess);
+  if (gs_app_read_table(m, path, &controls) != 0) goto done;
+  *T0 = states.time[states.nrow - 1] - states.time[0];
+  go_gait_opts to;
+  go_gait_opts_default(&to);
+  to.N = go->N;
+  to.T = *T0;
+  if (go_gait_create(&tmp, m, &to, err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: predict: %s\n", err);
+    goto done;
+  }
+  const go_gait_layout* L = go_gait_layout_get(tmp);
+  size_t nzN = (size_t)go->N * (size_t)L->nz;
+  *band = (double*)calloc(nzN + 1 + 2 * (size_t)nv, sizeof(double));
+  if (!*band) goto done;
+  if (go_gait_guess_from_solution(tmp, &states, &controls, 1.0, o->activation, *band, err,
+                                  sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s: %s\n", o->guess, err);
+    goto done;
+  }
+  if (L->tx < 0) {
+    fprintf(stderr, "gaitsim: predict: the model has no pelvis_tx (forward translation)\n");
+    goto done;
+  }
+  *dx0 = (*band)[nzN - L->nz + L->x_q + L->tx] - (*band)[L->x_q + L->tx];
+  (*band)[nzN] = *T0;
+  double* bq = *band + nzN + 1;
+  double* bqd = bq + nv;
+  for (int j = 0; j < nv; j++) {
+    int slide = m->jnt_type[m->dof_jntid[j]] == mjJNT_SLIDE;
+    bq[j] = slide ? PREDICT_BAND_TRANS : PREDICT_BAND_ROT;
+    bqd[j] = slide ? PREDICT_BAND_TRANS_SPEED : PREDICT_BAND_ROT_SPEED;
+  }
+  go->w_cot = 1.0;
+  go->speed = o->speed;
+  go->free_time = 1;
+  go->T_lb = 0.4;
+  go->T_ub = 2.5;
+  go->band_z = *band;
+  go->band_q = bq;
+  go->band_qd = bqd;
+  rc = 0;
+done:
+  go_gait_free(tmp);
+  gs_table_free(&states);
+  gs_table_free(&controls);
+  return rc;
+}
+
+// scale the guess's forward progression (pelvis_tx relative to its start, its speed, q' and
+// acceleration) to the prescribed speed V over the guess's stride time T0; set T = T0
+static void retime_progression(const go_gait* g, double* z, double V, double T0) {
+  const go_gait_layout* L = go_gait_layout_get(g);
+  int N = go_gait_nodes(g), nz = L->nz;
+  double tx0 = z[L->x_q + L->tx], dx = z[(size_t)(N - 1) * nz + L->x_q + L->tx] - tx0;
+  double f = fabs(dx) > 1e-9 ? V * T0 / dx : 1.0;
+  for (int k = 0; k < N; k++) {
+    double* zk = z + (size_t)k * nz;
+    zk[L->x_q + L->tx] = tx0 + f * (zk[L->x_q + L->tx] - tx0);
+    zk[L->x_qd + L->tx] *= f;
+    zk[L->xd_q + L->tx] *= f;
+    zk[L->xd_qdd + L->tx] *= f;
+  }
+  z[(size_t)N * nz] = T0;
+}
+
+// prediction figures for summary.json: speed, stride time and length and their change from the
+// guess, cost of transport, share of the regularisation, peak triceps surae excitations
+static void predict_summary(const go_gait* g, const double* z, const gsTrackOptions* o, double T0,
+                            double dx0, double objective, cJSON* summary) {
+  const mjModel* m = go_gait_model(g);
+  const go_gait_layout* L = go_gait_layout_get(g);
+  int N = go_gait_nodes(g);
+  double T = go_gait_time_of(g, z);
+  double dx = z[(size_t)(N - 1) * L->nz + L->x_q + L->tx] - z[L->x_q + L->tx];
+  double cot = go_gait_cot(g, z);
+  cJSON_AddNumberToObject(summary, "speed_target_mps", o->speed);
+  cJSON_AddNumberToObject(summary, "stride_length_m", dx);
+  cJSON_AddNumberToObject(summary, "guess_stride_time_s", T0);
+  cJSON_AddNumberToObject(summary, "guess_stride_length_m", dx0);
+  cJSON_AddNumberToObject(summary, "stride_time_change_pct", 100 * (T / T0 - 1));
+  cJSON_AddNumberToObject(summary, "stride_length_change_pct", 100 * (dx / dx0 - 1));
+  cJSON_AddNumberToObject(summary, "cost_of_transport_j_per_kg_m", cot);
+  cJSON_AddNumberToObject(summary, "regularisation_share", objective > 0 ? 1 - cot / objective : NAN);
+  static const char* peaks[] = {"soleus", "gasmed", "gaslat", "soleus_l", "med_gas_l", "lat_gas_l"};
+  cJSON* pk = cJSON_AddObjectToObject(summary, "peak_excitation");
+  for (size_t q = 0; q < sizeof(peaks) / sizeof(peaks[0]); q++) {
+    int i = mj_name2id(m, mjOBJ_ACTUATOR, peaks[q]);
+    if (i < 0) continue;
+    double mx = 0;
+    for (int k = 0; k < N; k++) mx = fmax(mx, z[(size_t)k * L->nz + L->u_e + i]);
+    cJSON_AddNumberToObject(pk, peaks[q], mx);
+  }
+}
+
+static const char* kPredictUsage =
+    "usage: gaitsim predict --guess TRACK_DIR --speed V --out DIR [options]\n\n"
+    "Predictive solve of one stride at mean speed V (m/s), no data tracked (Lin, Walter & Pandy\n"
+    "2018): minimise the cost of transport (smooth Umberger 2010 metabolic energy / (mass x\n"
+    "distance)) with free stride time, periodic but for pelvis_tx, q and qdot within a band\n"
+    "around the guess (eq. 3: 20 deg, 5 cm, 6 rad/s, 1 m/s), started from the solution in\n"
+    "TRACK_DIR (its forward progression rescaled to V). Writes the files of `gaitsim track`;\n"
+    "summary.json adds stride time and length, their change from the guess, the cost of\n"
+    "transport and peak triceps surae excitations. Exit status 3 when the solver stopped short.\n\n"
+    "  --model FILE        MJCF model (default: mjmodels/jw_fullbody.xml)\n"
+    "  --nodes N           collocation nodes (default 20)\n"
+    "  --threads N         worker threads (default 2)\n"
+    "  --max-iter N        Ipopt iteration limit (default 1000)\n"
+    "  --max-time S        wall-clock limit, s (default none)\n"
+    "  --weight effort=W   weight of the mean squared excitation regularisation (default 0.01)\n"
+    "  --no-polish         no feasibility polish of a solve that stopped short\n"
+    "  --ipopt KEY=VALUE   extra Ipopt option (repeatable)\n";
+
+int gs_cmd_predict(int argc, char** argv) {
+  static const struct option options[] = {
+      {"guess", required_argument, NULL, 'g'},    {"speed", required_argument, NULL, 's'},
+      {"out", required_argument, NULL, 'o'},      {"model", required_argument, NULL, 'm'},
+      {"nodes", required_argument, NULL, 'n'},    {"threads", required_argument, NULL, 't'},
+      {"max-iter", required_argument, NULL, 'i'}, {"max-time", required_argument, NULL, 'T'},
+      {"weight", required_argument, NULL, 'w'},   {"no-polish", no_argument, NULL, 'P'},
+      {"ipopt", required_argument, NULL, 'p'},    {"help", no_argument, NULL, 'h'},
+      {NULL, 0, NULL, 0}};
+  gsTrackOptions o;
+  defaults(&o);
+  o.predict = 1;
+  o.nodes = 20;
+  o.w_effort = 0.01;
+  optind = 1;
+  int c, bad = 0;
+  char err[256], *end;
+  while ((c = getopt_long(argc, argv, "g:s:o:m:n:t:i:T:w:Pp:h", options, NULL)) != -1) {
+    switch (c) {
+      case 'g': o.guess = optarg; break;
+      case 's':
+        o.speed = strtod(optarg, &end);
+        bad |= *end || end == optarg || !(o.speed > 0 && o.speed < 10);
+        break;
+      case 'o': o.out = optarg; break;
+      case 'm': o.model = optarg; break;
+      case 'n': bad |= parse_int(optarg, 3, &o.nodes); break;
+      case 't': bad |= parse_int(optarg, 1, &o.threads) || o.threads > 64; break;
+      case 'i': bad |= parse_int(optarg, 0, &o.max_iter); break;
+      case 'T':
+        o.max_time = strtod(optarg, &end);
+        bad |= *end || end == optarg || !(o.max_time > 0);
+        break;
+      case 'w': bad |= parse_weight(optarg, &o); break;
+      case 'P': o.polish = 0; break;
+      case 'p':
+        if (go_ipopt_opts_add(&o.ipopt, optarg, err, sizeof(err)) != 0) {
+          fprintf(stderr, "gaitsim: predict: %s\n", err);
+          bad = 1;
+        }
+        break;
+      case 'h': fputs(kPredictUsage, stdout); return GS_EXIT_OK;
+      default: bad = 1;
+    }
+  }
+  if (bad || optind != argc || !o.guess || !o.out || !(o.speed > 0)) {
+    fputs(kPredictUsage, stderr);
+    return GS_EXIT_USAGE;
+  }
+  o.trial = o.guess;
+  return solve(o);
+}
+
 int gs_cmd_track(int argc, char** argv) {
   gsTrackOptions o;
   if (parse(argc, argv, &o) != 0) {
     fputs(kTrackUsage, stderr);
     return GS_EXIT_USAGE;
   }
+  return solve(o);
+}
+
+// the tracking (o.predict == 0) or predictive problem: build, guess, solve, polish, write
+static int solve(gsTrackOptions o) {
   mjModel* m = gs_app_load_model(o.model);
   if (!m) return GS_EXIT_FAILURE;
   int status = GS_EXIT_FAILURE;
@@ -415,39 +616,45 @@ int gs_cmd_track(int argc, char** argv) {
   double *z = NULL, *zb = NULL, *zs = NULL, *gv = NULL;
   cJSON* summary = NULL;
   char path[4096], err[1024];
-  snprintf(path, sizeof(path), "%s/coordinates.mot", o.trial);
-  if (gs_app_read_table(m, path, &coords) != 0) goto done;
-  snprintf(path, sizeof(path), "%s/grf.mot", o.trial);
-  if (gs_app_read_table(m, path, &grf) != 0) goto done;
+  const char* what = o.predict ? "predict" : "track";
+  double grf_scale = 0, *band = NULL, T0 = 0, dx0 = 0;
+  if (!o.predict) {
+    snprintf(path, sizeof(path), "%s/coordinates.mot", o.trial);
+    if (gs_app_read_table(m, path, &coords) != 0) goto done;
+    snprintf(path, sizeof(path), "%s/grf.mot", o.trial);
+    if (gs_app_read_table(m, path, &grf) != 0) goto done;
+    double model_weight = mj_getTotalmass(m) * mju_norm3(m->opt.gravity);
+    grf_scale = normalise_grf_to_weight(&grf, model_weight);
+    if (!(grf_scale > 0)) {
+      fprintf(stderr, "gaitsim: %s/grf.mot: no positive vertical ground reaction to normalise\n",
+              o.trial);
+      goto done;
+    }
+  }
   if (gs_mkdir_p(o.out, err, sizeof(err)) != 0) {
     fprintf(stderr, "gaitsim: %s: %s\n", o.out, err);
     goto done;
   }
-  double model_weight = 0;
-  for (int b = 1; b < m->nbody; b++) model_weight += m->body_mass[b];
-  model_weight *= mju_norm3(m->opt.gravity);
-  double grf_scale = normalise_grf_to_weight(&grf, model_weight);
-  if (!(grf_scale > 0)) {
-    fprintf(stderr, "gaitsim: %s/grf.mot: no positive vertical ground reaction to normalise\n",
-            o.trial);
-    goto done;
-  }
   go_gait_opts go;
   go_gait_opts_default(&go);
-  // the trial drifts sideways: pelvis_tz is not periodic (when the model has it)
+  // the trial drifts sideways: pelvis_tz is not periodic when tracking (if the model has it)
   static const char* free_coords[] = {"pelvis_tz", NULL};
   go.N = o.nodes;
   go.nthreads = o.threads;
-  go.coords = &coords;
-  go.grf = &grf;
-  go.free_coords = mj_name2id(m, mjOBJ_JOINT, "pelvis_tz") >= 0 ? free_coords : NULL;
-  go.w_pelvis_rot = o.w_pelvis_rot;
-  go.w_pelvis_trans = o.w_pelvis_trans;
-  go.w_joint = o.w_joint;
-  go.w_grf = o.w_grf;
   go.w_effort = o.w_effort;
+  if (!o.predict) {
+    go.coords = &coords;
+    go.grf = &grf;
+    go.free_coords = mj_name2id(m, mjOBJ_JOINT, "pelvis_tz") >= 0 ? free_coords : NULL;
+    go.w_pelvis_rot = o.w_pelvis_rot;
+    go.w_pelvis_trans = o.w_pelvis_trans;
+    go.w_joint = o.w_joint;
+    go.w_grf = o.w_grf;
+  } else if (predict_setup(m, &o, &go, &band, &T0, &dx0) != 0) {
+    goto done;
+  }
   if (go_gait_create(&g, m, &go, err, sizeof(err)) != 0) {
-    fprintf(stderr, "gaitsim: track: %s\n", err);
+    fprintf(stderr, "gaitsim: %s: %s\n", what, err);
     goto done;
   }
   go_nlp* nlp = go_gait_nlp(g);
@@ -457,7 +664,10 @@ int gs_cmd_track(int argc, char** argv) {
   zb = (double*)malloc(sizeof(double) * (size_t)n);
   zs = (double*)malloc(sizeof(double) * (size_t)n);
   gv = (double*)malloc(sizeof(double) * (size_t)mm);
-  if (o.init) {
+  if (o.predict) {
+    memcpy(z, band, sizeof(double) * (size_t)n);
+    retime_progression(g, z, o.speed, T0);
+  } else if (o.init) {
     if (guess_from_folder(g, m, o.init, o.activation, z) != 0) goto done;
   } else if (go_gait_guess_from_trial(g, &coords, o.activation, z, err, sizeof(err)) != 0) {
     fprintf(stderr, "gaitsim: track: %s\n", err);
@@ -465,10 +675,10 @@ int gs_cmd_track(int argc, char** argv) {
   }
   go_nlp_scale_z(nlp, z, zs);
   double viol0 = go_nlp_eval_g(nlp, zs, gv) == 0 ? go_nlp_violation(nlp, gv) : INFINITY;
-  fprintf(stderr, "track: %d nodes, %d variables, %d constraints, %d Jacobian nonzeros, %d "
-          "colour groups, %d threads; initial violation %.3g\n", o.nodes, n, mm, ne,
+  fprintf(stderr, "%s: %d nodes, %d variables, %d constraints, %d Jacobian nonzeros, %d "
+          "colour groups, %d threads; initial violation %.3g\n", what, o.nodes, n, mm, ne,
           go_nlp_path_groups(nlp), o.threads, viol0);
-  print_blocks(g, gv, "initial");
+  print_blocks(g, gv, o.predict ? "predict: initial" : "track: initial");
   o.ipopt.max_iter = o.max_iter;
   o.ipopt.max_wall_s = o.max_time;
   o.ipopt.progress = stderr;
@@ -509,7 +719,7 @@ int gs_cmd_track(int argc, char** argv) {
     go_ipopt_opts_set(&po, "mu_init", "1e-6", err, sizeof(err));
     go_ipopt_opts_set(&po, "bound_push", "1e-8", err, sizeof(err));
     go_ipopt_opts_set(&po, "bound_frac", "1e-8", err, sizeof(err));
-    fprintf(stderr, "track: feasibility polish from violation %.3g\n", viol_before);
+    fprintf(stderr, "%s: feasibility polish from violation %.3g\n", what, viol_before);
     int prc = go_ipopt_solve(nlp, &po, z, zs, NULL, &pres, err, sizeof(err));
     go_gait_set_proximal(g, NULL);
     if (prc != 0) {
@@ -529,12 +739,12 @@ int gs_cmd_track(int argc, char** argv) {
   double fout;
   double obj_out = go_nlp_eval_f(nlp, zs, &fout) == 0 ? go_nlp_objective_phys(nlp, fout) : NAN;
   double viol = go_nlp_eval_g(nlp, zs, gv) == 0 ? go_nlp_violation(nlp, gv) : INFINITY;
-  print_blocks(g, gv, "final");
+  print_blocks(g, gv, o.predict ? "predict: final" : "track: final");
   double max_defect = 0;
   const go_gait_layout* L = go_gait_layout_get(g);
   for (int r = 0; r < (o.nodes - 1) * L->nx; r++) max_defect = fmax(max_defect, fabs(gv[r]));
   summary = cJSON_CreateObject();
-  cJSON_AddStringToObject(summary, "problem", "tracking");
+  cJSON_AddStringToObject(summary, "problem", o.predict ? "prediction" : "tracking");
   cJSON_AddStringToObject(summary, "model", o.model);
   cJSON_AddStringToObject(summary, "trial", o.trial);
   cJSON_AddStringToObject(summary, "status", go_solve_status_str(res.status));
@@ -543,8 +753,12 @@ int gs_cmd_track(int argc, char** argv) {
   cJSON_AddNumberToObject(summary, "cpu_s", res.cpu_s);
   cJSON_AddNumberToObject(summary, "nodes", o.nodes);
   cJSON_AddNumberToObject(summary, "threads", o.threads);
-  cJSON_AddNumberToObject(summary, "stride_time_s", go_gait_stride_time(g));
-  cJSON_AddNumberToObject(summary, "grf_scale", grf_scale);
+  cJSON_AddNumberToObject(summary, "stride_time_s", go_gait_time_of(g, zout));
+  if (o.predict) {
+    predict_summary(g, zout, &o, T0, dx0, obj_out, summary);
+  } else {
+    cJSON_AddNumberToObject(summary, "grf_scale", grf_scale);
+  }
   cJSON_AddNumberToObject(summary, "objective", obj_out);
   if (polished || (!converged && o.polish && res.best_iter >= 0 && viol_before > 1e-8)) {
     cJSON* pj = cJSON_AddObjectToObject(summary, "polish");
@@ -558,7 +772,7 @@ int gs_cmd_track(int argc, char** argv) {
   cJSON_AddNumberToObject(summary, "max_violation", viol);
   cJSON_AddNumberToObject(summary, "max_defect", max_defect);
   cJSON_AddBoolToObject(summary, "best_iterate_written", zout == zb);
-  double* knee_ref = measured_knee_contact(o.trial, g);
+  double* knee_ref = o.predict ? NULL : measured_knee_contact(o.trial, g);
   int wrote_solution = write_solution(g, zout, o.out, knee_ref, summary);
   free(knee_ref);
   if (wrote_solution != 0) goto done;
@@ -571,13 +785,13 @@ int gs_cmd_track(int argc, char** argv) {
     fprintf(stderr, "gaitsim: %s: %s\n", path, err);
     goto done;
   }
-  printf("track: %s after %d iterations, %.1f s; max violation %.3g (from %.3g); wrote %s\n",
+  printf("%s: %s after %d iterations, %.1f s; max violation %.3g (from %.3g); wrote %s\n", what,
          go_solve_status_str(res.status), res.iterations, res.wall_s, viol, viol0, o.out);
   status = converged ? GS_EXIT_OK : GS_EXIT_STOPPED_SHORT;
 
 done:
   cJSON_Delete(summary);
-  free(z), free(zb), free(zs), free(gv);
+  free(z), free(zb), free(zs), free(gv), free(band);
   go_hess_free(hess);
   go_gait_free(g);
   gs_table_free(&coords);

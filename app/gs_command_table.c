@@ -9,6 +9,7 @@ const gsCommand gs_commands[] = {
     {"simulate", gs_cmd_simulate, "forward simulation with gaitsim's muscles and foot contact"},
     {"inspect", gs_cmd_inspect, "one row per muscle at one instant: lengths, force, metabolics, moment arms"},
     {"track", gs_cmd_track, "tracking solve of one stride by direct collocation"},
+    {"predict", gs_cmd_predict, "predictive solve at a new speed: minimum cost of transport, free stride time"},
     {"render", gs_cmd_render, "headless gait video, picture or filmstrip of a solution (OSMesa)"},
     {"report", gs_cmd_report, "figures and a table of a solution vs the measured trial (matplotlib)"},
     {NULL, NULL, NULL},

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "callbacks/gs_activation.h"
+#include "callbacks/gs_metabolics.h"
 #include "callbacks/gs_model_info.h"
 #include "callbacks/gs_muscle.h"
 #include "callbacks/gs_physics.h"
@@ -31,7 +32,12 @@ typedef struct {
   const go_gait* g;   // the problem (read only)
   mjData* d;          // this worker's data
   double* M;          // full mass matrix (nv x nv)
+  double* P;          // muscle powers (na)
+  double* Pm;         // muscle powers, - perturbation (na)
+  double* zp;         // perturbed node variables (nz)
 } gait_ctx;
+
+#define GO_GAIT_MAX_MUSCLES 512
 
 struct go_gait {
   mjModel* m;                 // private copy, constraint stage off
@@ -66,6 +72,11 @@ struct go_gait {
   double w_effort;            // effort weight / na
   int* ivars;                 // integrand variables
   int n_ivars;
+  double cot_scale;           // w_cot / (m V): metabolic integrand factor      (s / (kg m))
+  gsUmbergerMuscle* umus;     // metabolic parameters (na)
+  int free_time;              // T is the last NLP variable
+  go_bound_override* band;    // eq. 3 bounds as node overrides (n_band)
+  int n_band;
   double* prox_z0;            // proximal target z0 (N nz, physical) while polishing, else NULL
   double* prox_w;             // proximal weights 1 / z_scale^2 (nz)
   go_elements el;             // Hessian elements of a node (go_gait_elements)
@@ -281,6 +292,83 @@ static double proximal(const go_gait* g, int k, const double* z, double* dL, dou
   return s;
 }
 
+// muscle metabolic powers P (na, W) at the node state z: smooth Umberger 2010
+// (gs_umberger2010_smooth) with the fibre state of gs_physics_muscle_tension; position stage
+// recomputed only when `kinematics` (q or qdot changed)
+static void muscle_powers(const go_gait* g, mjData* d, const double* z, int kinematics,
+                          double* P) {
+  const go_gait_layout* L = &g->L;
+  const mjModel* m = g->m;
+  if (kinematics) {
+    mju_copy(d->qpos, z + L->x_q, L->nv);
+    mju_copy(d->qvel, z + L->x_qd, L->nv);
+    mj_fwdPosition(m, d);
+    mj_fwdVelocity(m, d);
+  }
+  mju_copy(d->act, z + L->x_a, L->na);
+  mju_copy(d->ctrl, z + L->u_e, L->na);
+  for (int e = 0; e < L->ne; e++) d->userdata[L->elastic[e]] = z[L->x_ft + e];
+  for (int i = 0; i < L->na; i++) {
+    gsMuscleOut out;
+    gs_physics_muscle_tension(m, d, i, &out);
+    gsUmbergerInput in = {d->ctrl[i], d->act[i], out.lM_norm, out.vM, out.f_active, out.fL};
+    P[i] = gs_umberger2010_smooth(&g->umus[i], &in, NULL, NULL);
+  }
+}
+
+static double sum(const double* x, int n) {
+  double s = 0;
+  for (int i = 0; i < n; i++) s += x[i];
+  return s;
+}
+
+// metabolic integrand cot_scale * sum_i P_i and its gradient (dL, added; NULL: none) by central
+// differences that use the structure: a_i, e_i and fT_e move only muscle i's power, so each of
+// the three is perturbed for all muscles at once (2 evaluations each, position stage reused);
+// q_j and qdot_j one at a time (2 nv evaluations)
+static double metabolic(const go_gait* g, gait_ctx* c, const double* z, double* dL) {
+  const go_gait_layout* L = &g->L;
+  int na = L->na, nz = L->nz;
+  double* P = c->P;
+  muscle_powers(g, c->d, z, 1, P);
+  double val = g->cot_scale * sum(P, na);
+  if (!dL) return val;
+  double* zp = c->zp;
+  double* Pm = c->Pm;
+  memcpy(zp, z, sizeof(double) * (size_t)nz);
+  // per-muscle variables, all muscles at once (kinematics of z still in c->d)
+  const int blocks[3][2] = {{L->x_a, na}, {L->u_e, na}, {L->x_ft, L->ne}};
+  for (int b = 0; b < 3; b++) {
+    int off = blocks[b][0], cnt = blocks[b][1];
+    double hs[GO_GAIT_MAX_MUSCLES];
+    for (int i = 0; i < cnt; i++) {
+      hs[i] = 1e-6 * fmax(1.0, fabs(z[off + i]));
+      zp[off + i] = z[off + i] + hs[i];
+    }
+    muscle_powers(g, c->d, zp, 0, P);
+    for (int i = 0; i < cnt; i++) zp[off + i] = z[off + i] - hs[i];
+    muscle_powers(g, c->d, zp, 0, Pm);
+    for (int i = 0; i < cnt; i++) {
+      int mi = b == 2 ? L->elastic[i] : i;
+      dL[off + i] += g->cot_scale * (P[mi] - Pm[mi]) / (2 * hs[i]);
+      zp[off + i] = z[off + i];
+    }
+  }
+  // coordinates and speeds
+  for (int v = 0; v < 2 * L->nv; v++) {
+    int j = (v < L->nv ? L->x_q : L->x_qd) + v % L->nv;
+    double h = 1e-6 * fmax(1.0, fabs(z[j]));
+    zp[j] = z[j] + h;
+    muscle_powers(g, c->d, zp, 1, P);
+    double sp = sum(P, na);
+    zp[j] = z[j] - h;
+    muscle_powers(g, c->d, zp, 1, Pm);
+    zp[j] = z[j];
+    dL[j] += g->cot_scale * (sp - sum(Pm, na)) / (2 * h);
+  }
+  return val;
+}
+
 static int integrand_cb(void* vctx, int k, const double* z, double* out) {
   const go_gait* g = ((gait_ctx*)vctx)->g;
   const go_gait_layout* L = &g->L;
@@ -288,7 +376,7 @@ static int integrand_cb(void* vctx, int k, const double* z, double* out) {
     *out = proximal(g, k, z, NULL, NULL);
     return isfinite(*out) ? 0 : -1;
   }
-  double s = 0;
+  double s = g->cot_scale > 0 ? metabolic(g, (gait_ctx*)vctx, z, NULL) : 0;
   for (int j = 0; j < L->nv; j++) {
     if (g->q_wt[j] > 0) {
       double err = z[L->x_q + j] - g->q_ref[k * L->nv + j];
@@ -316,6 +404,7 @@ static int integrand_grad_cb(void* vctx, int k, const double* z, double* dL) {
     return 0;
   }
   memset(dL, 0, sizeof(double) * (size_t)L->nz);
+  if (g->cot_scale > 0) metabolic(g, (gait_ctx*)vctx, z, dL);
   for (int j = 0; j < L->nv; j++) {
     if (g->q_wt[j] > 0) {
       dL[L->x_q + j] = 2 * g->q_wt[j] * (z[L->x_q + j] - g->q_ref[k * L->nv + j]);
@@ -496,7 +585,7 @@ void go_gait_free(go_gait* g) {
   go_nlp_free(g->nlp);
   for (int w = 0; g->ctx && w < g->nthreads; w++) {
     if (g->ctx[w].d) mj_deleteData(g->ctx[w].d);
-    free(g->ctx[w].M);
+    free(g->ctx[w].M), free(g->ctx[w].P), free(g->ctx[w].Pm), free(g->ctx[w].zp);
   }
   free(g->ctx);
   free(g->ctx_ptr);
@@ -506,7 +595,7 @@ void go_gait_free(go_gait* g) {
   free(g->z_lb), free(g->z_ub), free(g->z_scale), free(g->path_scale), free(g->bnd_var);
   free(g->bnd_col_ptr), free(g->bnd_row_idx), free(g->bnd_scale), free(g->q_ref);
   free(g->grf_ref), free(g->q_wt), free(g->ivars), free(g->el_mem), free(g->prox_z0);
-  free(g->prox_w);
+  free(g->prox_w), free(g->umus), free(g->band);
   free(g);
 }
 
@@ -564,6 +653,23 @@ static int build_elements(go_gait* g) {
 }
 
 const go_elements* go_gait_elements(const go_gait* g) { return &g->el; }
+
+double go_gait_time_of(const go_gait* g, const double* z) {
+  return g->free_time ? z[(size_t)g->N * g->L.nz] : g->T;
+}
+
+double go_gait_cot(const go_gait* g, const double* z) {
+  const go_gait_layout* L = &g->L;
+  if (L->tx < 0) return NAN;
+  double T = go_gait_time_of(g, z), h = T / (g->N - 1), E = 0;
+  gait_ctx* c = &g->ctx[0];
+  for (int k = 0; k < g->N; k++) {
+    muscle_powers(g, c->d, z + (size_t)k * L->nz, 1, c->P);
+    E += (k == 0 || k == g->N - 1 ? 0.5 : 1.0) * h * sum(c->P, L->na);
+  }
+  double dx = z[(size_t)(g->N - 1) * L->nz + L->x_q + L->tx] - z[L->x_q + L->tx];
+  return E / (mj_getTotalmass(g->m) * dx);
+}
 
 int go_gait_set_proximal(go_gait* g, const double* z0) {
   int n = g->N * g->L.nz;
@@ -672,6 +778,26 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   g->weight = mj_getTotalmass(m) * mju_norm3(m->opt.gravity);
   g->speed = o->speed > 0 ? o->speed : 0;
   g->nthreads = o->nthreads;
+  g->free_time = o->free_time;
+  if (na > GO_GAIT_MAX_MUSCLES || (o->w_cot > 0 && !(g->speed > 0)) ||
+      (o->free_time && !(o->T_lb > 0 && o->T_ub > o->T_lb))) {
+    snprintf(err, errsz, "go_gait_create: at most %d muscles; a cost-of-transport goal needs a "
+             "speed; free time needs 0 < T_lb < T_ub", GO_GAIT_MAX_MUSCLES);
+    go_gait_free(g);
+    return -1;
+  }
+  // cost of transport: integrand w_cot Edot / (m V); with J = I / T that is w_cot COT
+  g->cot_scale = o->w_cot > 0 ? o->w_cot / (mj_getTotalmass(m) * g->speed) : 0;
+  g->umus = (gsUmbergerMuscle*)zalloc((size_t)na, sizeof(gsUmbergerMuscle));
+  for (int i = 0; i < na; i++) {
+    if (gs_umberger_muscle_from_user(m->actuator_user + i * m->nuser_actuator, &g->umus[i], NULL,
+                                     0) != 0 && g->cot_scale > 0) {
+      snprintf(err, errsz, "go_gait_create: actuator %s has no metabolic parameters",
+               mj_id2name(m, mjOBJ_ACTUATOR, i));
+      go_gait_free(g);
+      return -1;
+    }
+  }
 
   // muscles
   g->mprm = (gsMuscleParams*)zalloc((size_t)na, sizeof(gsMuscleParams));
@@ -788,6 +914,13 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   g->ivars = (int*)zalloc((size_t)nz, sizeof(int));
   for (int j = 0; j < nv; j++) {
     if (g->q_wt[j] > 0) g->ivars[g->n_ivars++] = L->x_q + j;
+  }
+  if (g->cot_scale > 0) {  // the metabolic integrand reads q, qdot, a and fT as well
+    for (int j = 0; j < nv; j++)
+      if (!(g->q_wt[j] > 0)) g->ivars[g->n_ivars++] = L->x_q + j;
+    for (int j = 0; j < nv; j++) g->ivars[g->n_ivars++] = L->x_qd + j;
+    for (int i = 0; i < na; i++) g->ivars[g->n_ivars++] = L->x_a + i;
+    for (int e = 0; e < L->ne; e++) g->ivars[g->n_ivars++] = L->x_ft + e;
   }
   for (int i = 0; i < na; i++) g->ivars[g->n_ivars++] = L->u_e + i;
   if (g->w_grf > 0) {
@@ -907,6 +1040,7 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
     }
   }
   g->bnd_col_ptr[2 * nz] = nbe;
+  if (g->free_time && g->speed > 0) g->bnd_row_idx[nbe++] = nb;  // speed row: T column
   g->bnd_col_ptr[2 * nz + 1] = nbe;
   free(row_of);
   free(periodic);
@@ -919,8 +1053,11 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
     g->ctx[w].g = g;
     g->ctx[w].d = mj_makeData(m);
     g->ctx[w].M = (double*)zalloc((size_t)nv * nv, sizeof(double));
+    g->ctx[w].P = (double*)zalloc((size_t)na, sizeof(double));
+    g->ctx[w].Pm = (double*)zalloc((size_t)na, sizeof(double));
+    g->ctx[w].zp = (double*)zalloc((size_t)nz, sizeof(double));
     g->ctx_ptr[w] = &g->ctx[w];
-    if (!g->ctx[w].d || !g->ctx[w].M) {
+    if (!g->ctx[w].d || !g->ctx[w].M || !g->ctx[w].P || !g->ctx[w].Pm || !g->ctx[w].zp) {
       snprintf(err, errsz, "go_gait_create: out of memory");
       go_gait_free(g);
       return -1;
@@ -930,10 +1067,31 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   // the NLP
   go_problem p;
   memset(&p, 0, sizeof(p));
-  p.dims = (go_dims){g->N, L->nx, na + GO_GAIT_NGRF, L->n_path, g->n_bnd, 0};
+  p.dims = (go_dims){g->N, L->nx, na + GO_GAIT_NGRF, L->n_path, g->n_bnd, g->free_time};
   p.z_lb = g->z_lb;
   p.z_ub = g->z_ub;
   p.T = g->T;
+  p.T_lb = o->T_lb;
+  p.T_ub = o->T_ub;
+  p.T_scale = g->T;
+  // eq. 3 of Lin, Walter & Pandy 2018: q and qdot within a band around a given solution
+  if (o->band_z) {
+    g->band = (go_bound_override*)zalloc((size_t)4 * g->N * nv, sizeof(go_bound_override));
+    for (int k = 0; k < g->N; k++) {
+      const double* zk = o->band_z + (size_t)k * nz;
+      for (int j = 0; j < nv; j++) {
+        if (o->band_q && o->band_q[j] > 0 && j != L->tx)
+          g->band[g->n_band++] = (go_bound_override){k, L->x_q + j, zk[L->x_q + j] - o->band_q[j],
+                                                      zk[L->x_q + j] + o->band_q[j]};
+        if (o->band_qd && o->band_qd[j] > 0)
+          g->band[g->n_band++] = (go_bound_override){k, L->x_qd + j,
+                                                      zk[L->x_qd + j] - o->band_qd[j],
+                                                      zk[L->x_qd + j] + o->band_qd[j]};
+      }
+    }
+    p.overrides = g->band;
+    p.n_overrides = g->n_band;
+  }
   p.z_scale = g->z_scale;
   p.path_scale = g->path_scale;
   p.boundary_scale = g->bnd_scale;

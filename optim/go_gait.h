@@ -83,6 +83,15 @@ typedef struct {
   const char* const* free_coords;   // NULL-terminated coordinates left out of periodicity
                                     // besides pelvis_tx (NULL: none)
   double speed;                     // > 0: mean forward speed constraint                (m/s)
+  // prediction (Lin, Walter & Pandy 2018, eqs. 1-3)
+  double w_cot;                     // > 0: cost-of-transport goal weight: the integrand gains
+                                    // w_cot Edot / (m g V) ... see go_gait_cot             (-)
+  int free_time;                    // 1: stride time T is a variable in [T_lb, T_ub]
+  double T_lb, T_ub;                // bounds of T (s)
+  const double* band_z;             // NULL, or node variables (N nz, physical) of the solution
+                                    // the band of eq. 3 is centred on (the tracking solution)
+  const double* band_q;             // half-width per dof of the coordinate band (nv; <= 0: none)
+  const double* band_qd;            // half-width per dof of the speed band (nv; <= 0: none)
 } go_gait_opts;
 
 // Where everything sits in z_k and in the path rows of a node.
@@ -105,7 +114,8 @@ typedef struct {
 typedef struct go_gait go_gait;
 
 // defaults: N 40, 1 thread, T from coords, w_pelvis_rot 1, w_pelvis_trans 1, w_joint 1, w_grf 1,
-// w_effort 0.1, periodic 1, no free coordinates, no speed constraint
+// w_effort 0.1, periodic 1, no free coordinates, no speed constraint; no prediction (w_cot 0,
+// fixed time, no band)
 void go_gait_opts_default(go_gait_opts* opts);
 
 // Build the problem for model m (prepared by gs_physics_prepare; every actuator must be a gaitsim
@@ -130,6 +140,14 @@ int go_gait_dof_is_root(const mjModel* m, int j);
 // Hessian elements of one node for the partitioned quasi-Newton Hessian (go_hessian.h): the
 // dynamics (eom and grf rows), one per elastic tendon (hill row), one per muscle (activation row).
 const go_elements* go_gait_elements(const go_gait* g);
+
+// Stride time (s) of the NLP point z (N nz [+ 1], physical): the variable T with free time.
+double go_gait_time_of(const go_gait* g, const double* z);
+
+// Cost of transport J (J / (kg m)) of the physical point z: the trapezoidal integral of the
+// muscles' smooth Umberger 2010 metabolic power over the stride divided by the body mass and the
+// pelvis_tx displacement (Lin, Walter & Pandy 2018, eq. 1). NAN without pelvis_tx.
+double go_gait_cot(const go_gait* g, const double* z);
 
 // Feasibility polish: with z0 (N nz, physical; copied) the objective becomes the proximal term
 // sum_k w_k h sum_j ((z_kj - z0_kj) / z_scale_j)^2 / T instead of the tracking goals, so a solve

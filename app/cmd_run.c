@@ -1,7 +1,6 @@
-// cmd_run.c: `gaitsim run`: the default job on the bundled model and trial: the tracking solve of
-// JW's stride (Lin, Walter & Pandy 2018) by mesh continuation (20 nodes, then the requested
-// number started from it), then the report (figures and Table 1) and a video and a filmstrip of
-// the solution. Prediction joins when it lands (issue #8).
+// cmd_run.c: `gaitsim run`: the default job on the bundled model and trial (Lin, Walter & Pandy
+// 2018, reproduced): the tracking solve of JW's stride, predictions at 0.8 and 2.0 m/s started
+// from it, a report (figures, Table 1) and a video and filmstrip of each solution.
 #include <getopt.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -11,13 +10,17 @@
 #include "app/gs_commands.h"
 
 static const char* kRunUsage =
-    "usage: gaitsim run [--out DIR] [--nodes N] [--threads N] [--max-time S] [--no-video]\n\n"
+    "usage: gaitsim run [--out DIR] [--nodes N] [--threads N] [--max-time S] [--speeds LIST]\n"
+    "                   [--no-video]\n\n"
     "The default job on the bundled model and trial (mjmodels/jw_fullbody.xml,\n"
-    "mjmodels/trials/jw_ngait_og5): tracking solve on 20 nodes, then on N nodes (default 80)\n"
-    "started from it, then DIR/track/report/ (figures, report.md), DIR/track/gait.mp4 and\n"
-    "DIR/track/strip.png. Results in DIR (default\n"
-    "results/). Exit status as `gaitsim track` (3: a solve stopped short, its best iterate\n"
-    "written).\n\n"
+    "mjmodels/trials/jw_ngait_og5):\n"
+    "  1. DIR/track: tracking solve on N nodes (default 20; more nodes are solved on 20 first and\n"
+    "     continued), polished to a dynamically consistent point when it stops short;\n"
+    "  2. DIR/predict_V: predictive solve at each speed V of LIST (default 0.8,2.0 m/s) from it;\n"
+    "  3. DIR/*/report/: figures and report.md of every solution;\n"
+    "  4. DIR/*/gait.mp4 and strip.png: video (3 strides) and filmstrip of every solution.\n"
+    "Results in DIR (default results/). Exit status 0 when every solve converged, 3 when one\n"
+    "stopped short (its best iterate written), else as the failing step.\n\n"
     "  --max-time S   wall-clock limit of each solve, s (default 600)\n";
 
 // run one subcommand with the given words (argv[0] is the subcommand)
@@ -26,27 +29,44 @@ static int sub(gsCommandFn fn, const char* const* words) {
   while (words[argc]) argc++;
   char** argv = (char**)calloc((size_t)argc + 1, sizeof(char*));
   for (int i = 0; i < argc; i++) argv[i] = (char*)words[i];
+  fflush(stdout);
   int rc = fn(argc, argv);
   free(argv);
   return rc;
+}
+
+// report and pictures of the solution in dir
+static int show(const char* dir, int video) {
+  char mp4[4200], strip[4200];
+  snprintf(mp4, sizeof(mp4), "%s/gait.mp4", dir);
+  snprintf(strip, sizeof(strip), "%s/strip.png", dir);
+  const char* w_report[] = {"report", dir, NULL};
+  int rc = sub(gs_cmd_report, w_report);
+  if (rc != GS_EXIT_OK || !video) return rc;
+  const char* w_video[] = {"render", dir, "--out", mp4, "--cycles", "3", NULL};
+  const char* w_strip[] = {"render", dir, "--strip", strip, "--count", "8", NULL};
+  if ((rc = sub(gs_cmd_render, w_video)) != GS_EXIT_OK) return rc;
+  return sub(gs_cmd_render, w_strip);
 }
 
 int gs_cmd_run(int argc, char** argv) {
   static const struct option options[] = {
       {"out", required_argument, NULL, 'o'},      {"nodes", required_argument, NULL, 'n'},
       {"threads", required_argument, NULL, 't'},  {"max-time", required_argument, NULL, 'T'},
-      {"no-video", no_argument, NULL, 'V'},       {"help", no_argument, NULL, 'h'},
-      {NULL, 0, NULL, 0}};
-  const char *out = "results", *nodes = "80", *threads = "2", *max_time = "600";
+      {"speeds", required_argument, NULL, 's'},   {"no-video", no_argument, NULL, 'V'},
+      {"help", no_argument, NULL, 'h'},           {NULL, 0, NULL, 0}};
+  const char *out = "results", *nodes = "20", *threads = "2", *max_time = "600";
+  char speeds[256] = "0.8,2.0";
   int video = 1;
   optind = 1;
   int c;
-  while ((c = getopt_long(argc, argv, "o:n:t:T:Vh", options, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, "o:n:t:T:s:Vh", options, NULL)) != -1) {
     switch (c) {
       case 'o': out = optarg; break;
       case 'n': nodes = optarg; break;
       case 't': threads = optarg; break;
       case 'T': max_time = optarg; break;
+      case 's': snprintf(speeds, sizeof(speeds), "%s", optarg); break;
       case 'V': video = 0; break;
       case 'h': fputs(kRunUsage, stdout); return GS_EXIT_OK;
       default: fputs(kRunUsage, stderr); return GS_EXIT_USAGE;
@@ -57,39 +77,53 @@ int gs_cmd_run(int argc, char** argv) {
     return GS_EXIT_USAGE;
   }
   const char* trial = GAITSIM_SOURCE_DIR "/mjmodels/trials/jw_ngait_og5";
-  char coarse[4096], fine[4096], mp4[4200], strip[4200];
+  char coarse[4096], track[4096];
   snprintf(coarse, sizeof(coarse), "%s/track_n20", out);
-  snprintf(fine, sizeof(fine), "%s/track", out);
-  snprintf(mp4, sizeof(mp4), "%s/gait.mp4", fine);
-  snprintf(strip, sizeof(strip), "%s/strip.png", fine);
+  snprintf(track, sizeof(track), "%s/track", out);
+  int stopped_short = 0, rc;
 
-  printf("[1/4] tracking solve, 20 nodes -> %s\n", coarse);
-  fflush(stdout);
-  const char* w1[] = {"track", trial, "--out", coarse, "--nodes", "20", "--threads", threads,
-                      "--max-iter", "800", "--max-time", max_time, NULL};
-  int rc = sub(gs_cmd_track, w1);
+  // 1. tracking (20 nodes first when more are asked for)
+  int continued = strcmp(nodes, "20") != 0;
+  printf("[1] tracking solve of %s, %s nodes -> %s\n", trial, continued ? "20" : nodes,
+         continued ? coarse : track);
+  const char* w1[] = {"track", trial, "--out", continued ? coarse : track, "--nodes", "20",
+                      "--threads", threads, "--max-iter", "600", "--max-time", max_time, NULL};
+  rc = sub(gs_cmd_track, w1);
   if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
-  printf("[2/4] tracking solve, %s nodes, started from it -> %s\n", nodes, fine);
-  fflush(stdout);
-  const char* w2[] = {"track", trial, "--out", fine, "--nodes", nodes, "--threads", threads,
-                      "--init", coarse, "--max-iter", "1000", "--max-time", max_time, NULL};
-  rc = sub(gs_cmd_track, w2);
-  if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
-  int track_rc = rc;
-  printf("[3/4] report -> %s/report\n", fine);
-  fflush(stdout);
-  const char* w5[] = {"report", fine, NULL};
-  if ((rc = sub(gs_cmd_report, w5)) != GS_EXIT_OK) return rc;
-  if (video) {
-    printf("[4/4] video %s and filmstrip %s\n", mp4, strip);
-    fflush(stdout);
-    const char* w3[] = {"render", fine, "--out", mp4, "--cycles", "3", NULL};
-    const char* w4[] = {"render", fine, "--strip", strip, "--count", "8", NULL};
-    if ((rc = sub(gs_cmd_render, w3)) != GS_EXIT_OK) return rc;
-    if ((rc = sub(gs_cmd_render, w4)) != GS_EXIT_OK) return rc;
+  stopped_short |= rc == GS_EXIT_STOPPED_SHORT;
+  if (continued) {
+    printf("[1] tracking solve, %s nodes, started from it -> %s\n", nodes, track);
+    const char* w2[] = {"track", trial, "--out", track, "--nodes", nodes, "--threads", threads,
+                        "--init", coarse, "--max-iter", "1000", "--max-time", max_time, NULL};
+    rc = sub(gs_cmd_track, w2);
+    if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
+    stopped_short |= rc == GS_EXIT_STOPPED_SHORT;
   }
-  printf("run: results in %s (summary.json, *.sto, grf.mot, report/%s)%s\n", fine,
-         video ? ", gait.mp4, strip.png" : "",
-         track_rc == GS_EXIT_STOPPED_SHORT ? "; the solve stopped short: best iterate" : "");
-  return track_rc;
+
+  // 2. predictions
+  char dirs[8][4096];
+  int ndir = 0;
+  for (char* tok = strtok(speeds, ","); tok && ndir < 8; tok = strtok(NULL, ",")) {
+    snprintf(dirs[ndir], sizeof(dirs[ndir]), "%s/predict_%s", out, tok);
+    printf("[2] predictive solve at %s m/s from the tracking solution -> %s\n", tok, dirs[ndir]);
+    const char* w3[] = {"predict", "--guess", track, "--speed", tok, "--out", dirs[ndir],
+                        "--nodes", continued ? nodes : "20", "--threads", threads,
+                        "--max-time", max_time, NULL};
+    rc = sub(gs_cmd_predict, w3);
+    if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
+    stopped_short |= rc == GS_EXIT_STOPPED_SHORT;
+    ndir++;
+  }
+
+  // 3, 4. report and pictures
+  printf("[3] report%s of %s\n", video ? ", video and filmstrip" : "", track);
+  if ((rc = show(track, video)) != GS_EXIT_OK) return rc;
+  for (int i = 0; i < ndir; i++) {
+    printf("[3] report%s of %s\n", video ? ", video and filmstrip" : "", dirs[i]);
+    if ((rc = show(dirs[i], video)) != GS_EXIT_OK) return rc;
+  }
+  printf("run: results in %s (track/, predict_*/: summary.json, *.sto, grf.mot, report/%s)%s\n",
+         out, video ? ", gait.mp4, strip.png" : "",
+         stopped_short ? "; a solve stopped short: its best iterate, polished, is written" : "");
+  return stopped_short ? GS_EXIT_STOPPED_SHORT : GS_EXIT_OK;
 }

@@ -1,0 +1,40 @@
+#!/usr/bin/env bash
+# gaitsim predict end to end on a tiny problem: the fixture solution (tests/fixtures/solution_small)
+# as the guess, 5 nodes, 3 Ipopt iterations; the solve stops short (exit 3), the best iterate is
+# polished towards the dynamics (violation down 10-fold from the guess's; from this far the
+# polish does not reach feasibility), every file is written
+# and summary.json carries the prediction figures; bad usage exits 2, a missing guess exits 1
+# with one line naming the file.
+# usage: predict.sh GAITSIM SOURCE_DIR
+set -u
+gaitsim=$1 src=$2
+source "$(dirname "$0")/../cli_common.bash"
+
+"$gaitsim" predict --guess "$src/tests/fixtures/solution_small" --speed 0.8 --out pred \
+  --nodes 5 --max-iter 3 --threads 1 >/dev/null 2>log.txt
+status=$?
+check "stopped short: exit 3 (got $status)" test "$status" -eq 3
+for f in states.sto controls.sto grf.mot muscle_forces.sto knee_contact.sto summary.json; do
+  check "wrote $f" test -s "pred/$f"
+done
+check "summary figures" /usr/bin/python3 - pred/summary.json <<'PY'
+import json, math, sys
+s = json.load(open(sys.argv[1]))
+ok = (s["problem"] == "prediction" and s["speed_target_mps"] == 0.8
+      and 0.4 <= s["stride_time_s"] <= 2.5
+      and abs(s["stride_length_m"] / s["stride_time_s"] - 0.8) < 1e-4   # the speed row holds
+      and s["max_violation"] * 10 <= s["initial_violation"]
+      and math.isfinite(s["cost_of_transport_j_per_kg_m"]) and s["cost_of_transport_j_per_kg_m"] > 0
+      and s["polish"]["used"] and set(s["peak_excitation"]) >= {"soleus", "gasmed"})
+if not ok:
+    print(json.dumps(s, indent=1), file=sys.stderr)
+sys.exit(0 if ok else 1)
+PY
+
+"$gaitsim" predict --speed 0.8 --out x >/dev/null 2>&1
+check "no --guess: usage, exit 2" test $? -eq 2
+err=$("$gaitsim" predict --guess nowhere --speed 0.8 --out x 2>&1 >/dev/null)
+status=$?
+check "missing guess exits 1 (got $status)" test "$status" -eq 1
+check "one line naming the file" test "$(grep -c 'nowhere/states.sto' <<<"$err")" -eq 1
+finish

@@ -13,6 +13,7 @@
 
 #include "app/gs_app_model.h"
 #include "app/gs_commands.h"
+#include "callbacks/gs_knee.h"
 #include "callbacks/gs_physics.h"
 #include "callbacks/gs_state.h"
 #include "io/gs_atomic.h"
@@ -209,20 +210,48 @@ static double normalise_grf_to_weight(gsTable* grf, double weight) {
   return factor;
 }
 
-// Right (implant) knee contact force (N) at the loaded state d: the compressive axial force that
-// the knee_ty joint carries between tibial tray and femoral component. With the model's
-// placeholder knee (a stiff spring-damper on knee_ty, mjmodels/README.md) that is the spring-
-// damper force -(k (q - q_spring) + b qdot) along the joint axis; the axis points from the femoral
-// component to the tibial tray (-y of the femoral component), so compression (knee_ty below its
-// spring reference) gives a positive force. With the contact surrogate it will be the
-// surrogate's normal force. NAN without a knee_ty joint.
-static double knee_contact_total(const mjModel* m, const mjData* d) {
+// Right (implant) knee contact forces (N) at the loaded state d into f = {medial, lateral, total}.
+// A model with the gs_knee numerics (callbacks/gs_knee.h): the surrogate's compartment force
+// magnitudes (d->qfrc_passive gains the knee loads once more: d is scratch). The placeholder knee
+// (a stiff spring-damper on knee_ty, mjmodels/README.md): total only, the spring-damper force
+// -(k (q - q_spring) + b qdot) along the joint axis, which points from the femoral component to
+// the tibial tray (-y of the femoral component), so compression gives a positive force; medial
+// and lateral NAN. All NAN without a knee_ty joint.
+static void knee_contact(const mjModel* m, mjData* d, double f[3]) {
+  f[0] = f[1] = f[2] = NAN;
+  gsKneeLoads loads;
+  if (gs_knee_passive(m, d, &loads) == 1) {
+    f[0] = loads.contact.magnitude[0];
+    f[1] = loads.contact.magnitude[1];
+    f[2] = f[0] + f[1];
+    return;
+  }
   int j = mj_name2id(m, mjOBJ_JOINT, "knee_ty");
-  if (j < 0 || m->jnt_type[j] != mjJNT_SLIDE) return NAN;
+  if (j < 0 || m->jnt_type[j] != mjJNT_SLIDE) return;
   int qa = m->jnt_qposadr[j], da = m->jnt_dofadr[j];
   double spring = -m->jnt_stiffness[j] * (d->qpos[qa] - m->qpos_spring[qa]);
   double damper = -m->dof_damping[da] * d->qvel[da];
-  return spring + damper;
+  f[2] = spring + damper;
+}
+
+// knee_contact.sto: the columns that are finite at every node (none: no file)
+static int write_knee_table(const char* out, const gsTable* knee) {
+  const char* keep[3];
+  int n = 0;
+  for (int c = 0; c < knee->ncol; c++) {
+    int finite = 1;
+    for (int k = 0; k < knee->nrow; k++) finite &= isfinite(knee->data[k * knee->ncol + c]);
+    if (finite) keep[n++] = knee->labels[c];
+  }
+  if (n == 0) return 0;
+  gsTable sel;
+  gs_table_init(&sel);
+  char err[256];
+  int rc = gs_table_select(knee, keep, n, &sel, err, sizeof(err));
+  if (rc == 0) rc = gs_app_write_table(out, "knee_contact.sto", &sel);
+  else fprintf(stderr, "gaitsim: knee_contact.sto: %s\n", err);
+  gs_table_free(&sel);
+  return rc;
 }
 
 // write the solution tables and accumulate the RMS errors into summary; knee_ref: measured
@@ -248,7 +277,9 @@ static int write_solution(go_gait* g, const double* z, const char* out, const do
       gs_table_create(&controls, N, na, names, err, sizeof(err)) != 0 ||
       gs_grf_table_create(N, &grf, err, sizeof(err)) != 0 ||
       gs_table_create(&forces, N, na, names, err, sizeof(err)) != 0 ||
-      gs_table_create(&knee, N, 1, (const char*[]){"contact_total_r"}, err, sizeof(err)) != 0) {
+      gs_table_create(&knee, N, 3,
+                      (const char*[]){"contact_medial_r", "contact_lateral_r", "contact_total_r"},
+                      err, sizeof(err)) != 0) {
     fprintf(stderr, "gaitsim: track: %s\n", err);
     goto done;
   }
@@ -261,9 +292,9 @@ static int write_solution(go_gait* g, const double* z, const char* out, const do
     gs_state_table_set_row(m, d, t, &states, k);
     gs_grf_table_set_row(m, d, t, &grf, k);
     controls.time[k] = forces.time[k] = knee.time[k] = t;
-    knee.data[k] = knee_contact_total(m, d);
-    if (knee_ref && isfinite(knee.data[k]) && isfinite(knee_ref[k])) {
-      ss[6] += sq((knee.data[k] - knee_ref[k]) / bw);
+    knee_contact(m, d, knee.data + 3 * k);
+    if (knee_ref && isfinite(knee.data[3 * k + 2]) && isfinite(knee_ref[k])) {
+      ss[6] += sq((knee.data[3 * k + 2] - knee_ref[k]) / bw);
       cnt[6]++;
     }
     for (int i = 0; i < na; i++) {
@@ -313,7 +344,7 @@ static int write_solution(go_gait* g, const double* z, const char* out, const do
       gs_app_write_table(out, "controls.sto", &controls) == 0 &&
       gs_app_write_table(out, "grf.mot", &grf) == 0 &&
       gs_app_write_table(out, "muscle_forces.sto", &forces) == 0 &&
-      (!isfinite(knee.data[0]) || gs_app_write_table(out, "knee_contact.sto", &knee) == 0)) {
+      write_knee_table(out, &knee) == 0) {
     status = 0;
   }
 done:

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "callbacks/gs_activation.h"
+#include "callbacks/gs_knee.h"
 #include "callbacks/gs_model_info.h"
 #include "callbacks/gs_model_layout.h"
 #include "callbacks/gs_muscle.h"
@@ -191,8 +192,11 @@ void gs_physics_foot_grf(const mjModel* m, const mjData* d, int side, double fn_
   gs_contact_foot_grf(n, forces, points, NULL, NULL, fn_min, grf);
 }
 
+// mjcb_passive: foot-ground contact, and the implant knee's surrogate contact and ligaments when
+// the model carries the gs_knee numerics (callbacks/gs_knee.h; a no-op otherwise)
 static void gs_passive_callback(const mjModel* m, mjData* d) {
   gs_physics_contact_passive(m, d);
+  gs_knee_passive(m, d, NULL);
 }
 
 int gs_physics_prepare(mjModel* m, char* err, int errsz) {

@@ -10,6 +10,8 @@
 #include <mujoco/mujoco.h>
 
 #include "callbacks/gs_knee.h"
+#include "callbacks/gs_mujoco.h"
+#include "callbacks/gs_physics.h"
 #include "tests/gs_test.h"
 
 #define FIXTURE GAITSIM_SOURCE_DIR "/tests/fixtures/knee6.xml"
@@ -545,6 +547,49 @@ static void test_ligament_law(void) {
   EXPECT_REL(sl, sr, 1e-3, 1.0);
 }
 
+// The full model with the surrogate (mjmodels/jw_fullbody_knee6.xml, gaitsim's physics
+// installed): mjcb_passive applies the knee loads. With knee_ty 1 mm below its default the
+// tibia is pressed into the femoral component, so the knee_ty generalized force pushes the two
+// apart (> 0 along the axis, which points from the femoral component to the tibial tray) and
+// equals the generalized force gs_knee_passive reports (1e-9 N); with knee_ty 10 mm above
+// (distraction) the contact force is below 0.1 N (the smooth ramp gs_knee_ramp leaves 0.05 N).
+// Foot contact is far off the floor (pelvis raised).
+static void test_full_model_passive(void) {
+  char err[300];
+  mjModel* m = gs_model_load(GAITSIM_SOURCE_DIR "/mjmodels/jw_fullbody_knee6.xml", err,
+                             sizeof(err));
+  EXPECT_TRUE(m != NULL);
+  if (!m) {
+    fprintf(stderr, "test_knee: %s\n", err);
+    return;
+  }
+  EXPECT_EQ_INT(0, gs_physics_prepare(m, err, sizeof(err)));
+  gs_physics_install();
+  mjData* d = mj_makeData(m);
+  int ty = m->jnt_dofadr[mj_name2id(m, mjOBJ_JOINT, "knee_ty")];
+  int tz = m->jnt_dofadr[mj_name2id(m, mjOBJ_JOINT, "pelvis_ty")];
+  double offsets[2] = {-0.001, 0.010};
+  for (int c = 0; c < 2; c++) {
+    mj_resetData(m, d);
+    d->qpos[tz] += 1.0;
+    d->qpos[ty] += offsets[c];
+    mj_forward(m, d);
+    double applied = d->qfrc_passive[ty];
+    gsKneeLoads loads;
+    mju_zero(d->qfrc_passive, m->nv);
+    EXPECT_EQ_INT(1, gs_knee_passive(m, d, &loads));
+    if (c == 0) {
+      EXPECT_TRUE(applied > 10.0);
+      EXPECT_NEAR(loads.qfrc[GS_KNEE_TY], applied, 1e-9);
+      EXPECT_TRUE(loads.contact.magnitude[0] + loads.contact.magnitude[1] > 10.0);
+    } else {
+      EXPECT_NEAR(0.0, loads.contact.magnitude[0] + loads.contact.magnitude[1], 0.1);  // smooth ramp
+    }
+  }
+  mj_deleteData(d);
+  mj_deleteModel(m);
+}
+
 int main(void) {
   char err[300];
   mjModel* m = mj_loadXML(FIXTURE, NULL, err, sizeof(err));
@@ -578,6 +623,7 @@ int main(void) {
       mj_deleteModel(m0);
     }
   }
+  test_full_model_passive();
   free(rows);
   mj_deleteModel(m);
   return GS_TEST_RESULT();

@@ -440,6 +440,36 @@ done:
 
 static int solve(gsTrackOptions o);
 
+// the "trial" of DIR/summary.json (caller frees), or NULL when absent or unreadable
+static char* trial_of_solution(const char* dir) {
+  char path[4096];
+  snprintf(path, sizeof(path), "%s/summary.json", dir);
+  FILE* f = fopen(path, "rb");
+  if (!f) return NULL;
+  char* text = NULL;
+  size_t len = 0, cap = 0, got;
+  char buf[4096];
+  while ((got = fread(buf, 1, sizeof(buf), f)) > 0) {
+    if (len + got + 1 > cap) {
+      cap = 2 * (len + got + 1);
+      char* t = (char*)realloc(text, cap);
+      if (!t) break;
+      text = t;
+    }
+    memcpy(text + len, buf, got);
+    len += got;
+  }
+  fclose(f);
+  if (!text) return NULL;
+  text[len] = 0;
+  cJSON* j = cJSON_Parse(text);
+  free(text);
+  const cJSON* t = cJSON_GetObjectItemCaseSensitive(j, "trial");
+  char* out = cJSON_IsString(t) ? strdup(t->valuestring) : NULL;
+  cJSON_Delete(j);
+  return out;
+}
+
 // Predictive problem set-up (Lin, Walter & Pandy 2018, eqs. 1-3): the guess from o->guess at the
 // node times (band, N nz + 1 + 2 nv doubles: node variables, T, then the half-widths of the q and
 // qdot bands), cost of transport with free stride time and the mean speed, the band of eq. 3
@@ -777,7 +807,15 @@ static int solve(gsTrackOptions o) {
   summary = cJSON_CreateObject();
   cJSON_AddStringToObject(summary, "problem", o.predict ? "prediction" : "tracking");
   cJSON_AddStringToObject(summary, "model", o.model);
-  cJSON_AddStringToObject(summary, "trial", o.trial);
+  if (o.predict) {
+    // the measured trial behind the guess (for the report's reference curves), when it says
+    cJSON_AddStringToObject(summary, "guess", o.guess);
+    char* trial = trial_of_solution(o.guess);
+    if (trial) cJSON_AddStringToObject(summary, "trial", trial);
+    free(trial);
+  } else {
+    cJSON_AddStringToObject(summary, "trial", o.trial);
+  }
   cJSON_AddStringToObject(summary, "status", go_solve_status_str(res.status));
   cJSON_AddNumberToObject(summary, "iterations", res.iterations);
   cJSON_AddNumberToObject(summary, "wall_s", res.wall_s);

@@ -234,6 +234,107 @@ static void knee_contact(const mjModel* m, mjData* d, double f[3]) {
   f[2] = spring + damper;
 }
 
+// Name of node variable j (go_gait.h layout), e.g. "q.hip_flexion", "qddot.hip_flexion",
+// "a.soleus", "fT.soleus", "e.soleus", "grf.r_y": the columns of variables.sto
+static void variable_name(const go_gait* g, int j, char* buf, size_t n) {
+  const mjModel* m = go_gait_model(g);
+  const go_gait_layout* L = go_gait_layout_get(g);
+  int nv = L->nv, na = L->na, ne = L->ne;
+  const char* dof = NULL;
+  const char* kind = NULL;
+  int idx = -1;
+  struct { int off, count; const char* kind; int what; } blocks[] = {
+      {L->x_q, nv, "q", 0},      {L->x_qd, nv, "qdot", 0},   {L->x_a, na, "a", 1},
+      {L->x_ft, ne, "fT", 2},    {L->xd_q, nv, "dq", 0},     {L->xd_qdd, nv, "qddot", 0},
+      {L->xd_a, na, "adot", 1},  {L->xd_ft, ne, "dfT", 2},   {L->u_e, na, "e", 1},
+      {L->u_grf, GO_GAIT_NGRF, "grf", 3}};
+  for (size_t b = 0; b < sizeof(blocks) / sizeof(blocks[0]); b++) {
+    if (j < blocks[b].off || j >= blocks[b].off + blocks[b].count) continue;
+    kind = blocks[b].kind;
+    idx = j - blocks[b].off;
+    switch (blocks[b].what) {
+      case 0: dof = mj_id2name(m, mjOBJ_JOINT, m->dof_jntid[idx]); break;
+      case 1: dof = mj_id2name(m, mjOBJ_ACTUATOR, idx); break;
+      case 2: dof = mj_id2name(m, mjOBJ_ACTUATOR, L->elastic[idx]); break;
+      default: {
+        static const char* grf[GO_GAIT_NGRF] = {"r_x", "r_y", "r_z", "l_x", "l_y", "l_z"};
+        dof = grf[idx];
+      }
+    }
+  }
+  snprintf(buf, n, "%s.%s", kind ? kind : "z", dof ? dof : "?");
+}
+
+// variables.sto: every node variable (physical, radians), the exact restart of this solution
+// for --init (and, on a refined mesh, go_refine_trapezoid)
+static int write_variables(const go_gait* g, const double* z, const char* out) {
+  const go_gait_layout* L = go_gait_layout_get(g);
+  int N = go_gait_nodes(g), nz = L->nz, rc = -1;
+  char** labels = (char**)calloc((size_t)nz, sizeof(char*));
+  gsTable t;
+  gs_table_init(&t);
+  char err[256];
+  for (int j = 0; j < nz; j++) {
+    labels[j] = (char*)malloc(96);
+    variable_name(g, j, labels[j], 96);
+  }
+  if (gs_table_create(&t, N, nz, (const char* const*)labels, err, sizeof(err)) == 0) {
+    double T = go_gait_time_of(g, z);
+    for (int k = 0; k < N; k++) {
+      t.time[k] = T * k / (N - 1);
+      memcpy(t.data + (size_t)k * nz, z + (size_t)k * nz, sizeof(double) * (size_t)nz);
+    }
+    rc = gs_app_write_table(out, "variables.sto", &t);
+  } else {
+    fprintf(stderr, "gaitsim: variables.sto: %s\n", err);
+  }
+  gs_table_free(&t);
+  for (int j = 0; j < nz; j++) free(labels[j]);
+  free(labels);
+  return rc;
+}
+
+// Restart from DIR/variables.sto when it matches this problem's layout: the same nodes copied,
+// or a coarser mesh refined (go_refine_trapezoid). 1 done, 0 not usable (no file, other
+// layout or node count), -1 error (printed).
+static int guess_from_variables(const go_gait* g, const char* dir, double* z) {
+  const go_gait_layout* L = go_gait_layout_get(g);
+  int N = go_gait_nodes(g), nz = L->nz;
+  char path[4096], err[512], name[96];
+  snprintf(path, sizeof(path), "%s/variables.sto", dir);
+  gsTable t;
+  gs_table_init(&t);
+  if (gs_storage_read(path, &t, err, sizeof(err)) != 0) {
+    gs_table_free(&t);
+    return 0;
+  }
+  int ok = t.ncol == nz && t.nrow >= 2;
+  for (int j = 0; ok && j < nz; j++) {
+    variable_name(g, j, name, sizeof(name));
+    ok = strcmp(name, t.labels[j]) == 0;
+  }
+  double T = t.time[t.nrow - 1] - t.time[0];
+  int rc = 0;
+  if (ok && t.nrow == N) {
+    memcpy(z, t.data, sizeof(double) * (size_t)N * nz);
+    rc = 1;
+  } else if (ok && go_refine_trapezoid(L->nx, nz - 2 * L->nx, t.nrow, t.data, T, N, z) == 0) {
+    rc = 1;
+  }
+  if (rc == 1) {
+    for (size_t v = 0; v < (size_t)N * nz; v++)
+      if (!isfinite(z[v])) {
+        fprintf(stderr, "gaitsim: %s: non-finite value in column %s\n", path, t.labels[v % nz]);
+        rc = -1;
+        break;
+      }
+    if (rc == 1) fprintf(stderr, "track: start from %s (%d nodes%s)\n", path, t.nrow,
+                         t.nrow == N ? "" : ", refined");
+  }
+  gs_table_free(&t);
+  return rc;
+}
+
 // knee_contact.sto: the columns that are finite at every node (none: no file)
 static int write_knee_table(const char* out, const gsTable* knee) {
   const char* keep[3];
@@ -344,7 +445,7 @@ static int write_solution(go_gait* g, const double* z, const char* out, const do
       gs_app_write_table(out, "controls.sto", &controls) == 0 &&
       gs_app_write_table(out, "grf.mot", &grf) == 0 &&
       gs_app_write_table(out, "muscle_forces.sto", &forces) == 0 &&
-      write_knee_table(out, &knee) == 0) {
+      write_knee_table(out, &knee) == 0 && write_variables(g, z, out) == 0) {
     status = 0;
   }
 done:
@@ -729,7 +830,9 @@ static int solve(gsTrackOptions o) {
     memcpy(z, band, sizeof(double) * (size_t)n);
     retime_progression(g, z, o.speed, T0);
   } else if (o.init) {
-    if (guess_from_folder(g, m, o.init, o.activation, z) != 0) goto done;
+    int from_vars = guess_from_variables(g, o.init, z);
+    if (from_vars < 0 || (from_vars == 0 && guess_from_folder(g, m, o.init, o.activation, z) != 0))
+      goto done;
   } else if (go_gait_guess_from_trial(g, &coords, o.activation, z, err, sizeof(err)) != 0) {
     fprintf(stderr, "gaitsim: track: %s\n", err);
     goto done;

@@ -636,3 +636,24 @@ void go_nlp_reset_counts(go_nlp* nlp) {
 }
 
 const char* go_nlp_last_error(const go_nlp* nlp) { return nlp->err; }
+
+int go_refine_trapezoid(int nx, int nu, int N0, const double* z0, double T, int N, double* z) {
+  int nz = 2 * nx + nu;
+  if (N0 < 2 || N < N0 || (N - 1) % (N0 - 1) != 0 || !(T > 0)) return -1;
+  int r = (N - 1) / (N0 - 1);
+  double hf = T / (N - 1);  // fine step (s)
+  for (int i = 0; i + 1 < N0; i++) {
+    const double* a = z0 + (size_t)i * nz;
+    const double* b = a + nz;
+    for (int q = 0; q <= r; q++) {
+      double s = (double)q / r;
+      double* zk = z + ((size_t)i * r + q) * nz;
+      // derivatives and controls: linear in time
+      for (int j = nx; j < nz; j++) zk[j] = (1 - s) * a[j] + s * b[j];
+      // states: the interval's first node, then trapezoid steps
+      for (int j = 0; j < nx; j++)
+        zk[j] = q == 0 ? a[j] : zk[j - nz] + 0.5 * hf * (zk[j - nz + nx] + zk[nx + j]);
+    }
+  }
+  return 0;
+}

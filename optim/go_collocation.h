@@ -177,4 +177,13 @@ void go_nlp_counts(const go_nlp* nlp, go_eval_counts* counts);
 void go_nlp_reset_counts(go_nlp* nlp);
 const char* go_nlp_last_error(const go_nlp* nlp);
 
+// Mesh refinement that keeps every defect: node variables z0 (N0 nodes of nz = 2 nx + nu,
+// physical, over [0, T], T in s) onto N nodes, N - 1 a multiple r of N0 - 1 (e.g. 20 -> 39 -> 77).
+// Within each coarse interval the state derivatives and the controls are linear in time and the
+// states are integrated by the trapezoid from the interval's first node; the composite trapezoid
+// of a linear function is exact, so each interval ends on the coarse node again and every fine
+// defect is 0 when the coarse ones are. Path constraints at the new nodes err by the
+// interpolation (O(h^2)). Returns 0, or -1 when N - 1 is not a multiple of N0 - 1.
+int go_refine_trapezoid(int nx, int nu, int N0, const double* z0, double T, int N, double* z);
+
 #endif  // GAITSIM_OPTIM_GO_COLLOCATION_H_

@@ -157,7 +157,42 @@ static int cmp_pair(const void* a, const void* b) {
   return x[1] < y[1] ? -1 : (x[1] > y[1]);
 }
 
+// go_refine_trapezoid: a coarse trajectory that satisfies its trapezoidal defects (random
+// derivatives and controls, states integrated) refined 4x: the coarse nodes are kept, every fine
+// defect is below 1e-12, derivatives and controls are linear between coarse nodes.
+static void test_refine_keeps_defects(void) {
+  enum { NXr = 3, NUr = 2, NZr = 2 * NXr + NUr, N0 = 6, R = 4, N1 = (N0 - 1) * R + 1 };
+  double T = 1.7, h0 = T / (N0 - 1), h1 = T / (N1 - 1);
+  double z0[N0 * NZr], z1[N1 * NZr];
+  srand(11);
+  for (int k = 0; k < N0; k++)
+    for (int j = NXr; j < NZr; j++) z0[k * NZr + j] = (double)rand() / RAND_MAX * 4 - 2;
+  for (int j = 0; j < NXr; j++) z0[j] = 0.3 * j;
+  for (int k = 1; k < N0; k++)
+    for (int j = 0; j < NXr; j++)
+      z0[k * NZr + j] = z0[(k - 1) * NZr + j] +
+                        0.5 * h0 * (z0[(k - 1) * NZr + NXr + j] + z0[k * NZr + NXr + j]);
+  EXPECT_EQ_INT(-1, go_refine_trapezoid(NXr, NUr, N0, z0, T, N1 + 1, z1));
+  EXPECT_EQ_INT(0, go_refine_trapezoid(NXr, NUr, N0, z0, T, N1, z1));
+  double worst = 0, worst_node = 0, worst_lin = 0;
+  for (int k = 0; k + 1 < N1; k++)
+    for (int j = 0; j < NXr; j++) {
+      double d = z1[(k + 1) * NZr + j] - z1[k * NZr + j] -
+                 0.5 * h1 * (z1[k * NZr + NXr + j] + z1[(k + 1) * NZr + NXr + j]);
+      worst = fmax(worst, fabs(d));
+    }
+  for (int k = 0; k < N0; k++)
+    for (int j = 0; j < NZr; j++) worst_node = fmax(worst_node, fabs(z1[k * R * NZr + j] - z0[k * NZr + j]));
+  for (int j = NXr; j < NZr; j++)  // a quarter into the second coarse interval
+    worst_lin = fmax(worst_lin, fabs(z1[(R + 1) * NZr + j] -
+                                     (0.75 * z0[NZr + j] + 0.25 * z0[2 * NZr + j])));
+  EXPECT_NEAR(0.0, worst, 1e-12);
+  EXPECT_NEAR(0.0, worst_node, 1e-12);
+  EXPECT_NEAR(0.0, worst_lin, 1e-12);
+}
+
 int main(void) {
+  test_refine_keeps_defects();
   go_nlp* a = make(1, 0, 0);  // 1 thread, all finite differences
   go_nlp* b = make(2, 0, 1);  // 2 threads
   go_nlp* c = make(1, 1, 2);  // 1 thread, analytic columns

@@ -605,8 +605,10 @@ static int predict_setup(const mjModel* m, gsTrackOptions* o, go_gait_opts* go, 
   size_t nzN = (size_t)go->N * (size_t)L->nz;
   *band = (double*)calloc(nzN + 1 + 2 * (size_t)nv, sizeof(double));
   if (!*band) goto done;
-  if (go_gait_guess_from_solution(tmp, &states, &controls, 1.0, o->activation, *band, err,
-                                  sizeof(err)) != 0) {
+  int exact = guess_from_variables(tmp, o->guess, *band);  // variables.sto: the exact solution
+  if (exact < 0) goto done;
+  if (!exact && go_gait_guess_from_solution(tmp, &states, &controls, 1.0, o->activation, *band,
+                                            err, sizeof(err)) != 0) {
     fprintf(stderr, "gaitsim: %s: %s\n", o->guess, err);
     goto done;
   }

@@ -1,4 +1,4 @@
-# Slow end-to-end test of the gait collocation problem (optim/go_gait.h, app/cmd_track.c): the
+# Slow end-to-end test of the gait collocation problem (optim/go_gait.h, app/cmd_solve.c): the
 # tracking solve on jw_fullbody at 20 nodes, at most 200 Ipopt iterations. Passes when the solve
 # ran (exit 0 or 3 = stopped short, best iterate written), every output file exists, the summary
 # has no NaN, the feasibility polish took the best iterate (violation ~1e-3 after 200 L-BFGS

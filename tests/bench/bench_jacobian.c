@@ -12,7 +12,7 @@
 // is extrapolated as the dense wall per path evaluation measured at the largest small N times
 // 2 n N (labelled as such).
 //
-// The problem is built as `gaitsim track` builds it (app/cmd_track.c): the trial's coordinates and
+// The problem is built as `gaitsim track` builds it (app/cmd_solve.c): the trial's coordinates and
 // ground reactions, pelvis_tz not periodic, the tracking weights of the command, the guess from
 // the trial. The command's scaling of the measured ground reactions to the model's weight changes
 // only the objective's reference values, not the constraints, so it is left out here.
@@ -87,7 +87,7 @@ static void problem_free(bench_problem* p) {
   memset(p, 0, sizeof(*p));
 }
 
-// Build the tracking problem as app/cmd_track.c does, at N nodes with `threads` workers, and its
+// Build the tracking problem as app/cmd_solve.c does, at N nodes with `threads` workers, and its
 // guess from the trial (scaled). 0, or -1 with the reason on stderr.
 static int problem_build(bench_problem* p, const mjModel* m, const gsTable* coords,
                          const gsTable* grf, int N, int threads) {

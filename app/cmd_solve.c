@@ -1,7 +1,9 @@
-// cmd_track.c: `gaitsim track`: the tracking problem (Lin, Walter & Pandy 2018): one stride of the
-// full-body muscle-driven model by direct collocation (optim/go_gait.h), tracking the measured
-// coordinates and ground reactions of a trial; writes the solution as OpenSim storage files and a
-// summary.
+// cmd_solve.c: `gaitsim track` and `gaitsim predict` (Lin, Walter & Pandy 2018): one stride of
+// the full-body muscle-driven model by direct collocation (optim/go_gait.h), either tracking the
+// measured coordinates and ground reactions of a trial or, at a prescribed speed, minimising the
+// cost of transport from a tracking solution. Both share one pipeline: problem, initial guess,
+// Ipopt, feasibility polish of a solve that stopped short, and the solution folder (OpenSim
+// storage files, variables.sto for restarts, summary.json).
 #include <getopt.h>
 #include <math.h>
 #include <stdio.h>

@@ -933,6 +933,7 @@ static int solve(gsTrackOptions o) {
   cJSON_AddNumberToObject(summary, "nodes", o.nodes);
   cJSON_AddNumberToObject(summary, "threads", o.threads);
   cJSON_AddNumberToObject(summary, "stride_time_s", go_gait_time_of(g, zout));
+  cJSON_AddNumberToObject(summary, "body_weight_n", go_gait_weight(g));
   if (o.predict) {
     predict_summary(g, zout, &o, T0, dx0, obj_out, summary);
   } else {

@@ -10,6 +10,7 @@ const gsCommand gs_commands[] = {
     {"inspect", gs_cmd_inspect, "one row per muscle at one instant: lengths, force, metabolics, moment arms"},
     {"track", gs_cmd_track, "tracking solve of one stride by direct collocation"},
     {"predict", gs_cmd_predict, "predictive solve at a new speed: minimum cost of transport, free stride time"},
+    {"sweep", gs_cmd_sweep, "predictive solves over a range of speeds by continuation"},
     {"render", gs_cmd_render, "headless gait video, picture or filmstrip of a solution (OSMesa)"},
     {"report", gs_cmd_report, "figures and a table of a solution vs the measured trial (matplotlib)"},
     {NULL, NULL, NULL},

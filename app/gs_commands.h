@@ -17,6 +17,7 @@ int gs_cmd_run(int argc, char** argv);
 int gs_cmd_simulate(int argc, char** argv);
 int gs_cmd_track(int argc, char** argv);
 int gs_cmd_predict(int argc, char** argv);
+int gs_cmd_sweep(int argc, char** argv);
 int gs_cmd_inspect(int argc, char** argv);
 int gs_cmd_render(int argc, char** argv);
 int gs_cmd_report(int argc, char** argv);

@@ -1,0 +1,266 @@
+// cmd_sweep.c: `gaitsim sweep`: predictive solves over a range of speeds (issue #8) by
+// continuation: the speeds below the guess's speed are solved downwards and those above upwards,
+// each started from the nearest speed already solved (the first from the guess itself); the two
+// chains are independent and run in two processes. Writes DIR/predict_<V>/ per speed and
+// DIR/sweep.csv and DIR/sweep.md: stride time and length, cost of transport, peak vertical ground
+// reaction and peak right (implant) knee contact force per speed.
+#include <errno.h>
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cjson/cJSON.h>
+
+#include "app/gs_commands.h"
+#include "io/gs_atomic.h"
+#include "io/gs_storage.h"
+
+#define SWEEP_MAX_SPEEDS 64
+
+static const char* kSweepUsage =
+    "usage: gaitsim sweep --guess TRACK_DIR --speeds LIST --out DIR [options]\n\n"
+    "Predictive solves (gaitsim predict) at every speed of LIST, by continuation from the nearest\n"
+    "speed already solved; speeds below and above the guess's own speed run in two processes.\n"
+    "LIST is A:STEP:B (m/s, e.g. 0.8:0.2:2.0) or comma-separated speeds. Writes DIR/predict_V/\n"
+    "(the solver's progress in DIR/predict_V/log.txt), DIR/sweep.csv and DIR/sweep.md.\n\n"
+    "  --nodes N       collocation nodes (default 20)\n"
+    "  --max-time S    wall-clock limit of each solve, s (default 600)\n"
+    "  --max-iter N    Ipopt iteration limit of each solve (default 1000)\n";
+
+// speeds from "A:STEP:B" or "V1,V2,..." into v (ascending); count, or -1 when malformed
+static int parse_speeds(const char* s, double* v) {
+  char* end;
+  double a = strtod(s, &end);
+  int n = 0;
+  if (end != s && *end == ':') {
+    double step = strtod(end + 1, &end);
+    if (*end != ':') return -1;
+    double b = strtod(end + 1, &end);
+    if (*end || !(a > 0) || !(step > 0) || !(b >= a)) return -1;
+    for (double x = a; x <= b + 1e-9 && n < SWEEP_MAX_SPEEDS; x += step) v[n++] = x;
+  } else {
+    const char* p = s;
+    while (*p && n < SWEEP_MAX_SPEEDS) {
+      v[n] = strtod(p, &end);
+      if (end == p || !(v[n] > 0) || (*end && *end != ',')) return -1;
+      n++;
+      p = *end ? end + 1 : end;
+    }
+    for (int i = 1; i < n; i++)  // insertion sort: ascending
+      for (int j = i; j > 0 && v[j] < v[j - 1]; j--) {
+        double t = v[j];
+        v[j] = v[j - 1];
+        v[j - 1] = t;
+      }
+  }
+  return n;
+}
+
+// a whole file as a NUL-terminated string (caller frees), or NULL
+static char* slurp(const char* path) {
+  FILE* f = fopen(path, "rb");
+  if (!f) return NULL;
+  char* text = NULL;
+  size_t len = 0, got;
+  char buf[4096];
+  while ((got = fread(buf, 1, sizeof(buf), f)) > 0) {
+    char* t = (char*)realloc(text, len + got + 1);
+    if (!t) break;
+    text = t;
+    memcpy(text + len, buf, got);
+    len += got;
+  }
+  fclose(f);
+  if (text) text[len] = 0;
+  return text;
+}
+
+// the guess's mean speed (summary.json speed_mps), or NAN
+static double guess_speed(const char* dir) {
+  char path[4096];
+  snprintf(path, sizeof(path), "%s/summary.json", dir);
+  char* text = slurp(path);
+  cJSON* j = text ? cJSON_Parse(text) : NULL;
+  free(text);
+  const cJSON* v = cJSON_GetObjectItemCaseSensitive(j, "speed_mps");
+  double s = cJSON_IsNumber(v) ? v->valuedouble : NAN;
+  cJSON_Delete(j);
+  return s;
+}
+
+// largest value of column label in DIR/file, or NAN
+static double column_max(const char* dir, const char* file, const char* label) {
+  char path[4096], err[256];
+  snprintf(path, sizeof(path), "%s/%s", dir, file);
+  gsTable t;
+  gs_table_init(&t);
+  double mx = NAN;
+  if (gs_storage_read(path, &t, err, sizeof(err)) == 0) {
+    int c = gs_table_column(&t, label);
+    for (int k = 0; c >= 0 && k < t.nrow; k++)
+      if (!(t.data[k * t.ncol + c] <= mx)) mx = t.data[k * t.ncol + c];
+  }
+  gs_table_free(&t);
+  return mx;
+}
+
+// one predictive solve: speed v from guess into out, progress into out/log.txt
+static int solve_one(const char* guess, double v, const char* out, const char* nodes,
+                     const char* max_time, const char* max_iter) {
+  char speed[32], err[256], log[4200];
+  snprintf(speed, sizeof(speed), "%.4g", v);
+  if (gs_mkdir_p(out, err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s: %s\n", out, err);
+    return GS_EXIT_FAILURE;
+  }
+  snprintf(log, sizeof(log), "%s/log.txt", out);
+  fflush(stderr);
+  int saved = dup(2);
+  FILE* lf = fopen(log, "w");
+  if (lf) dup2(fileno(lf), 2);
+  char* argv[] = {"predict", "--guess", (char*)guess, "--speed", speed, "--out", (char*)out,
+                  "--nodes", (char*)nodes, "--threads", "1", "--max-time", (char*)max_time,
+                  "--max-iter", (char*)max_iter, NULL};
+  int rc = gs_cmd_predict(15, argv);
+  fflush(stderr);
+  if (lf) {
+    dup2(saved, 2);
+    fclose(lf);
+  }
+  close(saved);
+  printf("sweep: %s m/s from %s: exit %d (%s)\n", speed, guess, rc, out);
+  fflush(stdout);
+  return rc;
+}
+
+// solve the speeds idx[0..n) in order, each from the previous one (the first from guess)
+static int chain(const char* guess, const double* v, const int* idx, int n, const char* dir,
+                 const char* nodes, const char* max_time, const char* max_iter) {
+  char prev[4096], out[4096];
+  snprintf(prev, sizeof(prev), "%s", guess);
+  int worst = GS_EXIT_OK;
+  for (int i = 0; i < n; i++) {
+    snprintf(out, sizeof(out), "%s/predict_%.4g", dir, v[idx[i]]);
+    int rc = solve_one(prev, v[idx[i]], out, nodes, max_time, max_iter);
+    if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
+    if (rc == GS_EXIT_STOPPED_SHORT) worst = rc;
+    snprintf(prev, sizeof(prev), "%s", out);
+  }
+  return worst;
+}
+
+int gs_cmd_sweep(int argc, char** argv) {
+  static const struct option options[] = {
+      {"guess", required_argument, NULL, 'g'},   {"speeds", required_argument, NULL, 's'},
+      {"out", required_argument, NULL, 'o'},     {"nodes", required_argument, NULL, 'n'},
+      {"max-time", required_argument, NULL, 'T'}, {"max-iter", required_argument, NULL, 'i'},
+      {"help", no_argument, NULL, 'h'},
+      {NULL, 0, NULL, 0}};
+  const char *guess = NULL, *list = NULL, *dir = NULL, *nodes = "20", *max_time = "600",
+             *max_iter = "1000";
+  optind = 1;
+  int c;
+  while ((c = getopt_long(argc, argv, "g:s:o:n:T:i:h", options, NULL)) != -1) {
+    switch (c) {
+      case 'g': guess = optarg; break;
+      case 's': list = optarg; break;
+      case 'o': dir = optarg; break;
+      case 'n': nodes = optarg; break;
+      case 'T': max_time = optarg; break;
+      case 'i': max_iter = optarg; break;
+      case 'h': fputs(kSweepUsage, stdout); return GS_EXIT_OK;
+      default: fputs(kSweepUsage, stderr); return GS_EXIT_USAGE;
+    }
+  }
+  double v[SWEEP_MAX_SPEEDS];
+  int n = list ? parse_speeds(list, v) : -1;
+  if (optind != argc || !guess || !dir || n < 1) {
+    fputs(kSweepUsage, stderr);
+    return GS_EXIT_USAGE;
+  }
+  double v0 = guess_speed(guess);
+  if (!isfinite(v0)) {
+    fprintf(stderr, "gaitsim: %s/summary.json: no speed_mps (not a solution folder?)\n", guess);
+    return GS_EXIT_FAILURE;
+  }
+  char err[256];
+  if (gs_mkdir_p(dir, err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s: %s\n", dir, err);
+    return GS_EXIT_FAILURE;
+  }
+  // the chains: downwards from the guess's speed, upwards from it
+  int down[SWEEP_MAX_SPEEDS], up[SWEEP_MAX_SPEEDS], nd = 0, nu = 0;
+  for (int i = n - 1; i >= 0; i--)
+    if (v[i] < v0) down[nd++] = i;
+  for (int i = 0; i < n; i++)
+    if (v[i] >= v0) up[nu++] = i;
+  printf("sweep: %d speeds around the guess's %.3f m/s: %d downwards, %d upwards\n", n, v0, nd,
+         nu);
+  fflush(stdout);
+  int rc_down = GS_EXIT_OK, rc_up;
+  pid_t pid = nd > 0 && nu > 0 ? fork() : -1;
+  if (pid == 0) _exit(chain(guess, v, down, nd, dir, nodes, max_time, max_iter));
+  rc_up = chain(guess, v, up, nu, dir, nodes, max_time, max_iter);
+  if (pid > 0) {
+    int st = 0;
+    while (waitpid(pid, &st, 0) < 0 && errno == EINTR) {
+    }
+    rc_down = WIFEXITED(st) ? WEXITSTATUS(st) : GS_EXIT_FAILURE;
+  } else if (nd > 0) {
+    rc_down = chain(guess, v, down, nd, dir, nodes, max_time, max_iter);
+  }
+
+  // the table
+  char csv[16384], md[16384], path[4200], sol[4096];
+  int lc = snprintf(csv, sizeof(csv), "speed_mps,stride_time_s,stride_length_m,"
+                    "cost_of_transport_j_per_kg_m,peak_vertical_grf_bw,peak_knee_contact_r_bw,status\n");
+  int lm = snprintf(md, sizeof(md), "| speed (m/s) | stride time (s) | stride length (m) | cost of "
+                    "transport (J/(kg m)) | peak vertical GRF (BW) | peak knee contact, right (BW) "
+                    "| status |\n|---|---|---|---|---|---|---|\n");
+  for (int i = 0; i < n; i++) {
+    snprintf(sol, sizeof(sol), "%s/predict_%.4g", dir, v[i]);
+    snprintf(path, sizeof(path), "%s/summary.json", sol);
+    char* text = slurp(path);
+    cJSON* j = text ? cJSON_Parse(text) : NULL;
+    free(text);
+    const char* keys[4] = {"stride_time_s", "stride_length_m", "cost_of_transport_j_per_kg_m",
+                           "body_weight_n"};
+    double f[4];
+    for (int q = 0; q < 4; q++) {
+      const cJSON* x = cJSON_GetObjectItemCaseSensitive(j, keys[q]);
+      f[q] = cJSON_IsNumber(x) ? x->valuedouble : NAN;
+    }
+    const cJSON* st = cJSON_GetObjectItemCaseSensitive(j, "status");
+    const char* status = cJSON_IsString(st) ? st->valuestring : "missing";
+    double bw = f[3];  // the model's weight (N)
+    double grf = fmax(column_max(sol, "grf.mot", "ground_force_r_vy"),
+                      column_max(sol, "grf.mot", "ground_force_l_vy")) / bw;
+    double knee = column_max(sol, "knee_contact.sto", "contact_total_r") / bw;
+    if (lc < (int)sizeof(csv))
+      lc += snprintf(csv + lc, sizeof(csv) - (size_t)lc, "%.4g,%.4f,%.4f,%.3f,%.3f,%.3f,%s\n", v[i],
+                     f[0], f[1], f[2], grf, knee, status);
+    if (lm < (int)sizeof(md))
+      lm += snprintf(md + lm, sizeof(md) - (size_t)lm, "| %.4g | %.3f | %.3f | %.2f | %.2f | %.2f | %s |\n",
+                     v[i], f[0], f[1], f[2], grf, knee, status);
+    cJSON_Delete(j);
+  }
+  snprintf(path, sizeof(path), "%s/sweep.csv", dir);
+  int ok = gs_atomic_write_buffer(path, csv, strlen(csv), err, sizeof(err)) == 0;
+  snprintf(path, sizeof(path), "%s/sweep.md", dir);
+  ok = ok && gs_atomic_write_buffer(path, md, strlen(md), err, sizeof(err)) == 0;
+  if (!ok) {
+    fprintf(stderr, "gaitsim: %s: %s\n", path, err);
+    return GS_EXIT_FAILURE;
+  }
+  fputs(md, stdout);
+  for (int r = 0; r < 2; r++) {
+    int rc = r ? rc_up : rc_down;
+    if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
+  }
+  return rc_down == GS_EXIT_STOPPED_SHORT || rc_up == GS_EXIT_STOPPED_SHORT ? GS_EXIT_STOPPED_SHORT
+                                                                            : GS_EXIT_OK;
+}

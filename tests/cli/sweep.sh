@@ -1,0 +1,29 @@
+#!/usr/bin/env bash
+# gaitsim sweep on a tiny problem: the fixture solution (given a speed of 1.27 m/s) as the guess,
+# speeds 0.9 (below: the downward chain, in the forked process) and 1.6 (upward chain), 5 nodes,
+# 2 Ipopt iterations each; exit 3 (solves stopped short), one folder per speed with its target
+# speed and log, a table with one row per speed in ascending order; a malformed list exits 2.
+# usage: sweep.sh GAITSIM SOURCE_DIR
+set -u
+gaitsim=$1 src=$2
+source "$(dirname "$0")/../cli_common.bash"
+
+cp -r "$src/tests/fixtures/solution_small" guess
+/usr/bin/python3 - guess/summary.json <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1])); s["speed_mps"] = 1.27
+json.dump(s, open(sys.argv[1], "w"))
+PY
+"$gaitsim" sweep --guess guess --speeds 0.9,1.6 --out sw --nodes 5 --max-iter 2 >out.txt 2>err.txt
+status=$?
+check "stopped short: exit 3 (got $status)" test "$status" -eq 3
+for v in 0.9 1.6; do
+  check "predict_$v summary" grep -q "\"speed_target_mps\":\s*$v" "sw/predict_$v/summary.json"
+  check "predict_$v log" grep -q '^iter' "sw/predict_$v/log.txt"
+done
+check "csv: header and two rows" test "$(wc -l < sw/sweep.csv)" -eq 3
+check "csv rows ascending" test "$(cut -d, -f1 sw/sweep.csv | tail -n 2 | tr '\n' ' ')" = "0.9 1.6 "
+check "markdown table" grep -q '^| 1.6 |' sw/sweep.md
+"$gaitsim" sweep --guess guess --speeds 0.8:x:2 --out sw2 >/dev/null 2>&1
+check "malformed speeds: exit 2" test $? -eq 2
+finish

@@ -1,6 +1,7 @@
 // cmd_run.c: `gaitsim run`: the default job on the bundled model and trial (Lin, Walter & Pandy
-// 2018, reproduced): the tracking solve of JW's stride, predictions at 0.8 and 2.0 m/s started
-// from it, a report (figures, Table 1) and a video and filmstrip of each solution.
+// 2018, reproduced): the tracking solve of JW's stride, predictions from 0.8 to 2.0 m/s by
+// continuation from it (gaitsim sweep), a report (figures, Table 1) and a video and filmstrip of
+// each solution.
 #include <getopt.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -16,12 +17,14 @@ static const char* kRunUsage =
     "mjmodels/trials/jw_ngait_og5):\n"
     "  1. DIR/track: tracking solve on N nodes (default 20; more nodes are solved on 20 first and\n"
     "     continued), polished to a dynamically consistent point when it stops short;\n"
-    "  2. DIR/predict_V: predictive solve at each speed V of LIST (default 0.8,2.0 m/s) from it;\n"
+    "  2. DIR/sweep/predict_V: predictive solves at the speeds of LIST (default 0.8:0.4:2.0 m/s,\n"
+    "     gaitsim sweep: 0.8 continued from 1.2, 2.0 from 1.6) from it, DIR/sweep/sweep.md;\n"
     "  3. DIR/*/report/: figures and report.md of every solution;\n"
     "  4. DIR/*/gait.mp4 and strip.png: video (3 strides) and filmstrip of every solution.\n"
     "Results in DIR (default results/). Exit status 0 when every solve converged, 3 when one\n"
     "stopped short (its best iterate written), else as the failing step.\n\n"
-    "  --max-time S   wall-clock limit of each solve, s (default 600)\n";
+    "  --max-time S   wall-clock limit of each predictive solve, s (default 200); the tracking\n"
+    "                 solve stops after 600 iterations (1000 on a continued mesh)\n";
 
 // run one subcommand with the given words (argv[0] is the subcommand)
 static int sub(gsCommandFn fn, const char* const* words) {
@@ -55,8 +58,8 @@ int gs_cmd_run(int argc, char** argv) {
       {"threads", required_argument, NULL, 't'},  {"max-time", required_argument, NULL, 'T'},
       {"speeds", required_argument, NULL, 's'},   {"no-video", no_argument, NULL, 'V'},
       {"help", no_argument, NULL, 'h'},           {NULL, 0, NULL, 0}};
-  const char *out = "results", *nodes = "20", *threads = "2", *max_time = "600";
-  char speeds[256] = "0.8,2.0";
+  const char *out = "results", *nodes = "20", *threads = "2", *max_time = "200";
+  char speeds[256] = "0.8:0.4:2.0";
   int video = 1;
   optind = 1;
   int c;
@@ -87,34 +90,43 @@ int gs_cmd_run(int argc, char** argv) {
   printf("[1] tracking solve of %s, %s nodes -> %s\n", trial, continued ? "20" : nodes,
          continued ? coarse : track);
   const char* w1[] = {"track", trial, "--out", continued ? coarse : track, "--nodes", "20",
-                      "--threads", threads, "--max-iter", "600", "--max-time", max_time, NULL};
+                      "--threads", threads, "--max-iter", "600", NULL};
   rc = sub(gs_cmd_track, w1);
   if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
   stopped_short |= rc == GS_EXIT_STOPPED_SHORT;
   if (continued) {
     printf("[1] tracking solve, %s nodes, started from it -> %s\n", nodes, track);
     const char* w2[] = {"track", trial, "--out", track, "--nodes", nodes, "--threads", threads,
-                        "--init", coarse, "--max-iter", "1000", "--max-time", max_time, NULL};
+                        "--init", coarse, "--max-iter", "1000", NULL};
     rc = sub(gs_cmd_track, w2);
     if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
     stopped_short |= rc == GS_EXIT_STOPPED_SHORT;
   }
 
-  // 2. predictions
-  char dirs[8][4096];
-  int ndir = 0;
-  for (char* tok = strtok(speeds, ","); tok && ndir < 8; tok = strtok(NULL, ",")) {
-    snprintf(dirs[ndir], sizeof(dirs[ndir]), "%s/predict_%s", out, tok);
-    printf("[2] predictive solve at %s m/s from the tracking solution -> %s\n", tok, dirs[ndir]);
-    const char* w3[] = {"predict", "--guess", track, "--speed", tok, "--out", dirs[ndir],
-                        "--nodes", continued ? nodes : "20", "--threads", threads,
-                        "--max-time", max_time, NULL};
-    rc = sub(gs_cmd_predict, w3);
-    if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
-    stopped_short |= rc == GS_EXIT_STOPPED_SHORT;
-    ndir++;
+  // 2. predictions by continuation (gaitsim sweep): 0.8 from 1.2, 2.0 from 1.6 m/s
+  char sweep_dir[4096];
+  snprintf(sweep_dir, sizeof(sweep_dir), "%s/sweep", out);
+  printf("[2] predictive solves at %s m/s by continuation from the tracking solution -> %s\n",
+         speeds, sweep_dir);
+  const char* w3[] = {"sweep", "--guess", track, "--speeds", speeds, "--out", sweep_dir,
+                      "--nodes", continued ? nodes : "20", "--max-time", max_time, NULL};
+  rc = sub(gs_cmd_sweep, w3);
+  if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
+  stopped_short |= rc == GS_EXIT_STOPPED_SHORT;
+  double v[16];
+  int nv = 0;
+  FILE* f = NULL;
+  char csv[4200];
+  snprintf(csv, sizeof(csv), "%s/sweep.csv", sweep_dir);
+  if ((f = fopen(csv, "r")) != NULL) {
+    char line[512];
+    if (fgets(line, sizeof(line), f))  // header
+      while (nv < 16 && fgets(line, sizeof(line), f)) v[nv++] = strtod(line, NULL);
+    fclose(f);
   }
-
+  char dirs[16][4200];
+  int ndir = 0;
+  for (int i = 0; i < nv; i++) snprintf(dirs[ndir++], sizeof(dirs[0]), "%s/predict_%.4g", sweep_dir, v[i]);
   // 3, 4. report and pictures
   printf("[3] report%s of %s\n", video ? ", video and filmstrip" : "", track);
   if ((rc = show(track, video)) != GS_EXIT_OK) return rc;
@@ -122,7 +134,8 @@ int gs_cmd_run(int argc, char** argv) {
     printf("[3] report%s of %s\n", video ? ", video and filmstrip" : "", dirs[i]);
     if ((rc = show(dirs[i], video)) != GS_EXIT_OK) return rc;
   }
-  printf("run: results in %s (track/, predict_*/: summary.json, *.sto, grf.mot, report/%s)%s\n",
+  printf("run: results in %s (track/, sweep/predict_*/: summary.json, *.sto, grf.mot, report/%s; "
+         "sweep/sweep.md)%s\n",
          out, video ? ", gait.mp4, strip.png" : "",
          stopped_short ? "; a solve stopped short: its best iterate, polished, is written" : "");
   return stopped_short ? GS_EXIT_STOPPED_SHORT : GS_EXIT_OK;

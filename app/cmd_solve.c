@@ -550,26 +550,7 @@ static int solve(gsTrackOptions o);
 static char* trial_of_solution(const char* dir) {
   char path[4096];
   snprintf(path, sizeof(path), "%s/summary.json", dir);
-  FILE* f = fopen(path, "rb");
-  if (!f) return NULL;
-  char* text = NULL;
-  size_t len = 0, cap = 0, got;
-  char buf[4096];
-  while ((got = fread(buf, 1, sizeof(buf), f)) > 0) {
-    if (len + got + 1 > cap) {
-      cap = 2 * (len + got + 1);
-      char* t = (char*)realloc(text, cap);
-      if (!t) break;
-      text = t;
-    }
-    memcpy(text + len, buf, got);
-    len += got;
-  }
-  fclose(f);
-  if (!text) return NULL;
-  text[len] = 0;
-  cJSON* j = cJSON_Parse(text);
-  free(text);
+  cJSON* j = gs_app_read_json(path);
   const cJSON* t = cJSON_GetObjectItemCaseSensitive(j, "trial");
   char* out = cJSON_IsString(t) ? strdup(t->valuestring) : NULL;
   cJSON_Delete(j);

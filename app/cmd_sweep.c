@@ -15,6 +15,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "app/gs_app_model.h"
 #include "app/gs_commands.h"
 #include "io/gs_atomic.h"
 #include "io/gs_storage.h"
@@ -60,32 +61,11 @@ static int parse_speeds(const char* s, double* v) {
   return n;
 }
 
-// a whole file as a NUL-terminated string (caller frees), or NULL
-static char* slurp(const char* path) {
-  FILE* f = fopen(path, "rb");
-  if (!f) return NULL;
-  char* text = NULL;
-  size_t len = 0, got;
-  char buf[4096];
-  while ((got = fread(buf, 1, sizeof(buf), f)) > 0) {
-    char* t = (char*)realloc(text, len + got + 1);
-    if (!t) break;
-    text = t;
-    memcpy(text + len, buf, got);
-    len += got;
-  }
-  fclose(f);
-  if (text) text[len] = 0;
-  return text;
-}
-
 // the guess's mean speed (summary.json speed_mps), or NAN
 static double guess_speed(const char* dir) {
   char path[4096];
   snprintf(path, sizeof(path), "%s/summary.json", dir);
-  char* text = slurp(path);
-  cJSON* j = text ? cJSON_Parse(text) : NULL;
-  free(text);
+  cJSON* j = gs_app_read_json(path);
   const cJSON* v = cJSON_GetObjectItemCaseSensitive(j, "speed_mps");
   double s = cJSON_IsNumber(v) ? v->valuedouble : NAN;
   cJSON_Delete(j);
@@ -224,9 +204,7 @@ int gs_cmd_sweep(int argc, char** argv) {
   for (int i = 0; i < n; i++) {
     snprintf(sol, sizeof(sol), "%s/predict_%.4g", dir, v[i]);
     snprintf(path, sizeof(path), "%s/summary.json", sol);
-    char* text = slurp(path);
-    cJSON* j = text ? cJSON_Parse(text) : NULL;
-    free(text);
+    cJSON* j = gs_app_read_json(path);
     const char* keys[4] = {"stride_time_s", "stride_length_m", "cost_of_transport_j_per_kg_m",
                            "body_weight_n"};
     double f[4];

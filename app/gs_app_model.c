@@ -2,6 +2,10 @@
 #include "app/gs_app_model.h"
 
 #include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <cjson/cJSON.h>
 
 #include "callbacks/gs_mujoco.h"
 #include "callbacks/gs_physics.h"
@@ -44,4 +48,25 @@ int gs_app_write_table(const char* dir, const char* name, const gsTable* t) {
     return -1;
   }
   return 0;
+}
+
+cJSON* gs_app_read_json(const char* path) {
+  FILE* f = fopen(path, "rb");
+  if (!f) return NULL;
+  char* text = NULL;
+  size_t len = 0, got;
+  char buf[4096];
+  while ((got = fread(buf, 1, sizeof(buf), f)) > 0) {
+    char* t = (char*)realloc(text, len + got + 1);
+    if (!t) break;
+    text = t;
+    memcpy(text + len, buf, got);
+    len += got;
+  }
+  fclose(f);
+  if (!text) return NULL;
+  text[len] = 0;
+  cJSON* j = cJSON_Parse(text);
+  free(text);
+  return j;
 }

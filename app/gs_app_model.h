@@ -19,6 +19,10 @@ int gs_app_read_table(const mjModel* m, const char* path, gsTable* t);
 // returns -1 on failure.
 int gs_app_write_table(const char* dir, const char* name, const gsTable* t);
 
+// Parse the JSON file at path (e.g. a solution's summary.json). Returns the document (caller
+// frees with cJSON_Delete), or NULL when the file is missing, unreadable or not JSON.
+struct cJSON* gs_app_read_json(const char* path);
+
 // Default bundled model: GAITSIM_SOURCE_DIR/mjmodels/jw_fullbody.xml.
 #define GS_DEFAULT_MODEL GAITSIM_SOURCE_DIR "/mjmodels/jw_fullbody.xml"
 

@@ -13,6 +13,7 @@
 #include "callbacks/gs_mujoco.h"
 #include "callbacks/gs_physics.h"
 #include "tests/gs_test.h"
+#include "tests/gs_test_csv.h"
 
 #define FIXTURE GAITSIM_SOURCE_DIR "/tests/fixtures/knee6.xml"
 #define HELDOUT GAITSIM_SOURCE_DIR "/mjmodels/knee/jw_knee_heldout.csv"
@@ -27,32 +28,7 @@
 
 // held-out table: q (6) then medial F M, lateral F M (12)
 static int read_heldout(double rows[MAXROWS][18]) {
-  FILE* f = fopen(HELDOUT, "r");
-  char line[2048];
-  int n = 0;
-  if (!f) {
-    return -1;
-  }
-  while (n < MAXROWS && fgets(line, sizeof(line), f)) {
-    if (line[0] == '#') {
-      continue;
-    }
-    char* p = line;
-    int k = 0;
-    for (; k < 18; k++) {
-      char* end;
-      rows[n][k] = strtod(p, &end);
-      if (end == p) {
-        break;
-      }
-      p = (*end == ',') ? end + 1 : end;
-    }
-    if (k == 18) {
-      n++;
-    }
-  }
-  fclose(f);
-  return n;
+  return gs_test_read_csv_rows(HELDOUT, 18, 18, &rows[0][0], MAXROWS);
 }
 
 // ---- elastic foundation: sphere of radius R pressed by depth d into a layer on a rigid base ----

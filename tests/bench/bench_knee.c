@@ -10,6 +10,7 @@
 #include <mujoco/mujoco.h>
 
 #include "callbacks/gs_knee.h"
+#include "tests/gs_test_csv.h"
 
 #define MAXROWS 64
 
@@ -26,30 +27,7 @@ static int cmp(const void* a, const void* b) {
 
 // poses (first 6 numbers of every non-comment row)
 static int read_poses(const char* path, double q[MAXROWS][6]) {
-  FILE* f = fopen(path, "r");
-  char line[2048];
-  int n = 0;
-  if (!f) {
-    return -1;
-  }
-  while (n < MAXROWS && fgets(line, sizeof(line), f)) {
-    if (line[0] == '#') {
-      continue;
-    }
-    char* p = line;
-    int k = 0;
-    for (; k < 6; k++) {
-      char* end;
-      q[n][k] = strtod(p, &end);
-      if (end == p) {
-        break;
-      }
-      p = (*end == ',') ? end + 1 : end;
-    }
-    n += k == 6;
-  }
-  fclose(f);
-  return n;
+  return gs_test_read_csv_rows(path, 6, 6, &q[0][0], MAXROWS);
 }
 
 // the refined surfaces written by scripts/prepare_knee.py

@@ -3,7 +3,8 @@
 // each started from the nearest speed already solved (the first from the guess itself); the two
 // chains are independent and run in two processes. Writes DIR/predict_<V>/ per speed and
 // DIR/sweep.csv and DIR/sweep.md: stride time and length, cost of transport, peak vertical ground
-// reaction and peak right (implant) knee contact force per speed.
+// reaction and peak knee contact force of both knees per speed (right: the implant knee, the one
+// measured in vivo; left: the 1-DOF knee's joint reaction, callbacks/gs_knee_reaction.h), in BW.
 #include <errno.h>
 #include <getopt.h>
 #include <math.h>
@@ -197,10 +198,11 @@ int gs_cmd_sweep(int argc, char** argv) {
   // the table
   char csv[16384], md[16384], path[4200], sol[4096];
   int lc = snprintf(csv, sizeof(csv), "speed_mps,stride_time_s,stride_length_m,"
-                    "cost_of_transport_j_per_kg_m,peak_vertical_grf_bw,peak_knee_contact_r_bw,status\n");
+                    "cost_of_transport_j_per_kg_m,peak_vertical_grf_bw,peak_knee_contact_r_bw,"
+                    "peak_knee_contact_l_bw,status\n");
   int lm = snprintf(md, sizeof(md), "| speed (m/s) | stride time (s) | stride length (m) | cost of "
                     "transport (J/(kg m)) | peak vertical GRF (BW) | peak knee contact, right (BW) "
-                    "| status |\n|---|---|---|---|---|---|---|\n");
+                    "| peak knee contact, left (BW) | status |\n|---|---|---|---|---|---|---|---|\n");
   for (int i = 0; i < n; i++) {
     snprintf(sol, sizeof(sol), "%s/predict_%.4g", dir, v[i]);
     snprintf(path, sizeof(path), "%s/summary.json", sol);
@@ -218,12 +220,14 @@ int gs_cmd_sweep(int argc, char** argv) {
     double grf = fmax(column_max(sol, "grf.mot", "ground_force_r_vy"),
                       column_max(sol, "grf.mot", "ground_force_l_vy")) / bw;
     double knee = column_max(sol, "knee_contact.sto", "contact_total_r") / bw;
+    double knee_l = column_max(sol, "knee_contact.sto", "contact_total_l") / bw;
     if (lc < (int)sizeof(csv))
-      lc += snprintf(csv + lc, sizeof(csv) - (size_t)lc, "%.4g,%.4f,%.4f,%.3f,%.3f,%.3f,%s\n", v[i],
-                     f[0], f[1], f[2], grf, knee, status);
+      lc += snprintf(csv + lc, sizeof(csv) - (size_t)lc, "%.4g,%.4f,%.4f,%.3f,%.3f,%.3f,%.3f,%s\n",
+                     v[i], f[0], f[1], f[2], grf, knee, knee_l, status);
     if (lm < (int)sizeof(md))
-      lm += snprintf(md + lm, sizeof(md) - (size_t)lm, "| %.4g | %.3f | %.3f | %.2f | %.2f | %.2f | %s |\n",
-                     v[i], f[0], f[1], f[2], grf, knee, status);
+      lm += snprintf(md + lm, sizeof(md) - (size_t)lm,
+                     "| %.4g | %.3f | %.3f | %.2f | %.2f | %.2f | %.2f | %s |\n", v[i], f[0], f[1],
+                     f[2], grf, knee, knee_l, status);
     cJSON_Delete(j);
   }
   snprintf(path, sizeof(path), "%s/sweep.csv", dir);

@@ -70,6 +70,9 @@ struct go_gait {
   double* q_wt;               // tracking weight / scale^2 / count per dof (nv)
   double w_grf;               // grf weight / scale^2 / 6
   double w_effort;            // effort weight / na
+  double w_accel;             // acceleration weight / GO_GAIT_ACCEL_SCALE^2 / nv  (s^4, s^4/m^2)
+  double* path_lb;            // path row bounds, physical (n_path): 0, fibre rows fibre_lo
+  double* path_ub;            // (n_path): 0, fibre rows fibre_hi
   int* ivars;                 // integrand variables
   int n_ivars;
   double cot_scale;           // w_cot / (m V): metabolic integrand factor      (s / (kg m))
@@ -81,6 +84,8 @@ struct go_gait {
   double* prox_w;             // proximal weights 1 / z_scale^2 (nz)
   go_elements el;             // Hessian elements of a node (go_gait_elements)
   int* el_mem;                // their arrays, one allocation
+  unsigned char* el_lin;      // per element variable: 1 where the element is linear (go_elements)
+  unsigned char* el_pairs;    // nz x nz: q/qdot pairs with possible mixed curvature (go_elements)
   gait_ctx* ctx;              // (nthreads)
   void** ctx_ptr;             // (nthreads)
   int nthreads;
@@ -97,6 +102,8 @@ void go_gait_opts_default(go_gait_opts* o) {
   o->w_grf = 1.0;
   o->w_effort = 0.1;
   o->periodic = 1;
+  o->fibre_lo = 0.25;
+  o->fibre_hi = 1.5;
 }
 
 go_nlp* go_gait_nlp(go_gait* g) { return g->nlp; }
@@ -142,6 +149,27 @@ static double tension(const go_gait* g, const mjData* d, const double* z, int i,
   return F;
 }
 
+// normalised fibre length lM / lopt (-) of muscle i at the loaded state (Lin, Walter & Pandy
+// 2018, eq. 2's bounded quantity): tendon length lts fT^-1(fT) (elastic) or lts (rigid), fibre
+// at constant thickness (gs_muscle_fibre_length); d/dfT (-) into *dfT (elastic, else 0)
+static double fibre_norm(const go_gait* g, const mjData* d, const double* z, int i, double* dfT) {
+  const gsMuscleParams* p = &g->mprm[i];
+  int e = g->L.elastic_of[i];
+  double lT = p->lts, dlT = 0, c;
+  if (e >= 0) {
+    lT = p->lts * gs_muscle_ft_inverse(z[g->L.x_ft + e], p->kT, &dlT);
+    dlT *= p->lts;  // m per unit fT
+  }
+  double lM = gs_muscle_fibre_length(p, d->actuator_length[i], lT, &c, NULL);
+  if (dfT) *dfT = -c * dlT / p->lopt;  // dlM/dlT = -cos(alpha)
+  return lM / p->lopt;
+}
+
+void go_gait_fibre_lengths(const go_gait* g, mjData* d, const double* z, double* lm_norm) {
+  go_gait_load_node(g, d, z);
+  for (int i = 0; i < g->L.na; i++) lm_norm[i] = fibre_norm(g, d, z, i, NULL);
+}
+
 int go_gait_path_eval(const go_gait* g, mjData* d, const double* z, double* res) {
   const go_gait_layout* L = &g->L;
   const mjModel* m = g->m;
@@ -183,6 +211,10 @@ int go_gait_path_eval(const go_gait* g, mjData* d, const double* z, double* res)
     for (int c = 0; c < 3; c++) {
       res[L->r_grf + 3 * s + c] = z[L->u_grf + 3 * s + c] - fg.force[c];
     }
+  }
+  // normalised fibre lengths (bounded by path_lb, path_ub)
+  for (int i = 0; L->r_fib >= 0 && i < L->na; i++) {
+    res[L->r_fib + i] = fibre_norm(g, d, z, i, NULL);
   }
   for (int r = 0; r < L->n_path; r++) {
     if (!isfinite(res[r])) {
@@ -245,10 +277,13 @@ static int path_jac_cb(void* vctx, int k, const double* z, double* vals) {
       gsMuscleGrad gr;
       gs_muscle_equilibrium_residual(&g->mprm[i], z[L->x_a + i], d->actuator_length[i],
                                      d->actuator_velocity[i], z[col], z[L->xd_ft + e], &gr, NULL);
+      double dfib = 0;
+      if (L->r_fib >= 0) fibre_norm(g, d, z, i, &dfib);
       for (int p = p0; p < p1; p++) {
         int r = g->row_idx[p];
-        vals[p] = r < L->r_hill ? d->actuator_moment[i * nv + r - L->r_eom] * g->mprm[i].fmax
-                                : gr.fT;
+        vals[p] = r < L->r_hill   ? d->actuator_moment[i * nv + r - L->r_eom] * g->mprm[i].fmax
+                  : r < L->r_act ? gr.fT
+                                 : dfib;  // the fibre row
       }
     } else if (col >= L->xd_a && col < L->xd_a + L->na) {  // adot
       vals[p0] = 1.0;
@@ -392,6 +427,9 @@ static int integrand_cb(void* vctx, int k, const double* z, double* out) {
   for (int i = 0; i < L->na; i++) {
     s += g->w_effort * z[L->u_e + i] * z[L->u_e + i];
   }
+  for (int j = 0; g->w_accel > 0 && j < L->nv; j++) {
+    s += g->w_accel * z[L->xd_qdd + j] * z[L->xd_qdd + j];
+  }
   *out = s;
   return isfinite(s) ? 0 : -1;
 }
@@ -418,6 +456,9 @@ static int integrand_grad_cb(void* vctx, int k, const double* z, double* dL) {
   for (int i = 0; i < L->na; i++) {
     dL[L->u_e + i] = 2 * g->w_effort * z[L->u_e + i];
   }
+  for (int j = 0; g->w_accel > 0 && j < L->nv; j++) {
+    dL[L->xd_qdd + j] = 2 * g->w_accel * z[L->xd_qdd + j];
+  }
   return 0;
 }
 
@@ -433,6 +474,7 @@ static int integrand_hess_cb(void* vctx, int k, const double* z, double* d2L) {
   for (int j = 0; j < L->nv; j++) d2L[L->x_q + j] = 2 * g->q_wt[j];
   for (int c = 0; c < GO_GAIT_NGRF; c++) d2L[L->u_grf + c] = 2 * g->w_grf;
   for (int i = 0; i < L->na; i++) d2L[L->u_e + i] = 2 * g->w_effort;
+  for (int j = 0; j < L->nv; j++) d2L[L->xd_qdd + j] = 2 * g->w_accel;
   return 0;
 }
 
@@ -530,6 +572,9 @@ static int pattern(const go_gait* g, int* col_ptr, int* row_idx) {
           for (int c = 0; c < 3; c++) PUT(L->r_grf + 3 * s + c);
         }
       }
+      for (int i = 0; L->r_fib >= 0 && col < L->x_qd && i < L->na; i++) {
+        if (g->cross[i * nv + j]) PUT(L->r_fib + i);  // lM(lMT(q))
+      }
     } else if (col < L->x_ft) {  // a
       int i = col - L->x_a;
       if (L->elastic_of[i] < 0) {
@@ -546,6 +591,7 @@ static int pattern(const go_gait* g, int* col_ptr, int* row_idx) {
         if (g->cross[i * nv + r]) PUT(L->r_eom + r);
       }
       PUT(L->r_hill + e);
+      if (L->r_fib >= 0) PUT(L->r_fib + i);  // lM(lT(fT))
     } else if (col < L->xd_qdd) {  // q'
       PUT(L->r_link + col - L->xd_q);
     } else if (col < L->xd_a) {  // qddot
@@ -594,20 +640,23 @@ void go_gait_free(go_gait* g) {
   free(g->tree), free(g->foot), free(g->col_ptr), free(g->row_idx), free(g->analytic);
   free(g->z_lb), free(g->z_ub), free(g->z_scale), free(g->path_scale), free(g->bnd_var);
   free(g->bnd_col_ptr), free(g->bnd_row_idx), free(g->bnd_scale), free(g->q_ref);
-  free(g->grf_ref), free(g->q_wt), free(g->ivars), free(g->el_mem), free(g->prox_z0);
-  free(g->prox_w), free(g->umus), free(g->band);
+  free(g->grf_ref), free(g->q_wt), free(g->ivars), free(g->el_mem), free(g->el_lin);
+  free(g->el_pairs), free(g->prox_z0);
+  free(g->prox_w), free(g->umus), free(g->band), free(g->path_lb), free(g->path_ub);
   free(g);
 }
 
 // Hessian elements of a node (go_hessian.h), variables in increasing node-variable order:
-//   dynamics      eom and grf rows over q, qdot, a (rigid muscles), fT, qddot
-//   tendon e      hill row e over q and qdot of the dofs muscle i crosses, a_i, fT_e, fT'_e
+//   dynamics      eom and grf rows (and the fibre rows of rigid muscles) over q, qdot, a (rigid
+//                 muscles), fT, qddot
+//   tendon e      hill row e (and muscle i's fibre row) over q and qdot of the dofs muscle i
+//                 crosses, a_i, fT_e, fT'_e
 //   activation i  act row i over a_i, e_i
 // (link rows are linear; the grf variables, q' and adot enter linearly).
 static int build_elements(go_gait* g) {
   const go_gait_layout* L = &g->L;
   int nv = L->nv, na = L->na, ne = L->ne, E = 1 + ne + na;
-  int nrows = 2 * nv + 2 * 0 + nv + GO_GAIT_NGRF + ne + na;  // generous
+  int nrows = 2 * nv + 2 * 0 + nv + GO_GAIT_NGRF + ne + 2 * na;  // generous
   int nvars = (3 * nv + na + ne) + ne * (2 * nv + 3) + 2 * na;
   int* mem = (int*)malloc(sizeof(int) * (size_t)(2 * (E + 1) + nrows + nvars));
   if (!mem) return -1;
@@ -617,6 +666,8 @@ static int build_elements(go_gait* g) {
   row_ptr[0] = var_ptr[0] = 0;
   for (int j = 0; j < nv; j++) rows[nr++] = L->r_eom + j;
   for (int c = 0; c < GO_GAIT_NGRF; c++) rows[nr++] = L->r_grf + c;
+  for (int i = 0; L->r_fib >= 0 && i < na; i++)
+    if (L->elastic_of[i] < 0) rows[nr++] = L->r_fib + i;
   for (int j = 0; j < nv; j++) vars[nvv++] = L->x_q + j;
   for (int j = 0; j < nv; j++) vars[nvv++] = L->x_qd + j;
   for (int i = 0; i < na; i++)
@@ -629,6 +680,7 @@ static int build_elements(go_gait* g) {
   for (int t = 0; t < ne; t++) {
     int i = L->elastic[t];
     rows[nr++] = L->r_hill + t;
+    if (L->r_fib >= 0) rows[nr++] = L->r_fib + i;
     for (int j = 0; j < nv; j++)
       if (g->cross[i * nv + j]) vars[nvv++] = L->x_q + j;
     for (int j = 0; j < nv; j++)
@@ -648,7 +700,24 @@ static int build_elements(go_gait* g) {
     var_ptr[e] = nvv;
   }
   g->el_mem = mem;
-  g->el = (go_elements){E, row_ptr, rows, var_ptr, vars};
+  // for the finite-difference Hessian: the dynamics rows are jointly linear in a (rigid), fT and
+  // qddot (M(q) qddot + moment(q) F(q, qdot) a + moment(q) Fmax fT); two coordinates (or speeds)
+  // have mixed curvature only on one branch of the kinematic tree or when a muscle crosses both
+  g->el_lin = (unsigned char*)calloc((size_t)nvv + 1, 1);
+  g->el_pairs = (unsigned char*)calloc((size_t)L->nz * (size_t)L->nz, 1);
+  if (!g->el_lin || !g->el_pairs) return -1;
+  for (int q = var_ptr[0]; q < var_ptr[1]; q++) g->el_lin[q] = vars[q] >= L->x_a;
+  for (int a = 0; a < nv; a++) {
+    for (int b = 0; b < nv; b++) {
+      int related = g->tree[a * nv + b];
+      for (int i = 0; i < na && !related; i++) related = g->cross[i * nv + a] && g->cross[i * nv + b];
+      if (!related) continue;
+      int va[2] = {L->x_q + a, L->x_qd + a}, vb[2] = {L->x_q + b, L->x_qd + b};
+      for (int s = 0; s < 2; s++)
+        for (int t = 0; t < 2; t++) g->el_pairs[(size_t)va[s] * L->nz + vb[t]] = 1;
+    }
+  }
+  g->el = (go_elements){E, row_ptr, rows, var_ptr, vars, g->el_lin, g->el_pairs};
   return 0;
 }
 
@@ -669,6 +738,35 @@ double go_gait_cot(const go_gait* g, const double* z) {
   }
   double dx = z[(size_t)(g->N - 1) * L->nz + L->x_q + L->tx] - z[L->x_q + L->tx];
   return E / (mj_getTotalmass(g->m) * dx);
+}
+
+int go_gait_objective_terms(const go_gait* g, const double* z, double* terms) {
+  const go_gait_layout* L = &g->L;
+  double T = go_gait_time_of(g, z), h = T / (g->N - 1);
+  for (int t = 0; t < GO_GAIT_NTERMS; t++) terms[t] = 0;
+  for (int k = 0; k < g->N; k++) {
+    const double* zk = z + (size_t)k * L->nz;
+    double w = (k == 0 || k == g->N - 1 ? 0.5 : 1.0) * h / T, v[GO_GAIT_NTERMS] = {0};
+    for (int j = 0; j < L->nv; j++) {
+      if (!(g->q_wt[j] > 0)) continue;
+      double err = zk[L->x_q + j] - g->q_ref[k * L->nv + j];
+      v[go_gait_dof_is_root(g->m, j) ? GO_GAIT_TERM_PELVIS : GO_GAIT_TERM_JOINTS] +=
+          g->q_wt[j] * err * err;
+    }
+    for (int c = 0; g->w_grf > 0 && c < GO_GAIT_NGRF; c++) {
+      double err = zk[L->u_grf + c] - g->grf_ref[k * GO_GAIT_NGRF + c];
+      v[GO_GAIT_TERM_GRF] += g->w_grf * err * err;
+    }
+    for (int i = 0; i < L->na; i++)
+      v[GO_GAIT_TERM_EFFORT] += g->w_effort * zk[L->u_e + i] * zk[L->u_e + i];
+    if (g->cot_scale > 0) v[GO_GAIT_TERM_COT] = metabolic(g, &g->ctx[0], zk, NULL);
+    for (int j = 0; g->w_accel > 0 && j < L->nv; j++)
+      v[GO_GAIT_TERM_ACCEL] += g->w_accel * zk[L->xd_qdd + j] * zk[L->xd_qdd + j];
+    for (int t = 0; t < GO_GAIT_NTERMS; t++) terms[t] += w * v[t];
+  }
+  for (int t = 0; t < GO_GAIT_NTERMS; t++)
+    if (!isfinite(terms[t])) return -1;
+  return 0;
 }
 
 int go_gait_set_proximal(go_gait* g, const double* z0) {
@@ -843,6 +941,16 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   L->r_act = 2 * nv + ne;
   L->r_grf = 2 * nv + ne + na;
   L->n_path = 2 * nv + ne + na + GO_GAIT_NGRF;
+  L->r_fib = -1;
+  if (o->fibre_bounds) {
+    if (!(o->fibre_lo >= 0 && o->fibre_hi > o->fibre_lo)) {
+      snprintf(err, errsz, "go_gait_create: fibre bounds need 0 <= fibre_lo < fibre_hi");
+      go_gait_free(g);
+      return -1;
+    }
+    L->r_fib = L->n_path;
+    L->n_path += na;
+  }
   L->elastic = g->elastic;
   L->elastic_of = g->elastic_of;
   L->tx = -1;
@@ -911,6 +1019,7 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   double grf_sc = TR_GRF * g->weight;
   g->w_grf = o->grf ? o->w_grf / (grf_sc * grf_sc) / GO_GAIT_NGRF : 0;
   g->w_effort = o->w_effort / na;
+  g->w_accel = o->w_accel > 0 ? o->w_accel / (GO_GAIT_ACCEL_SCALE * GO_GAIT_ACCEL_SCALE) / nv : 0;
   g->ivars = (int*)zalloc((size_t)nz, sizeof(int));
   for (int j = 0; j < nv; j++) {
     if (g->q_wt[j] > 0) g->ivars[g->n_ivars++] = L->x_q + j;
@@ -925,6 +1034,9 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   for (int i = 0; i < na; i++) g->ivars[g->n_ivars++] = L->u_e + i;
   if (g->w_grf > 0) {
     for (int c = 0; c < GO_GAIT_NGRF; c++) g->ivars[g->n_ivars++] = L->u_grf + c;
+  }
+  if (g->w_accel > 0) {
+    for (int j = 0; j < nv; j++) g->ivars[g->n_ivars++] = L->xd_qdd + j;
   }
 
   // bounds and scales
@@ -990,6 +1102,13 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   for (int e = 0; e < ne; e++) g->path_scale[L->r_hill + e] = 1;
   for (int i = 0; i < na; i++) g->path_scale[L->r_act + i] = SC_ADOT;
   for (int c = 0; c < GO_GAIT_NGRF; c++) g->path_scale[L->r_grf + c] = g->weight;
+  g->path_lb = (double*)zalloc((size_t)L->n_path, sizeof(double));
+  g->path_ub = (double*)zalloc((size_t)L->n_path, sizeof(double));
+  for (int i = 0; L->r_fib >= 0 && i < na; i++) {
+    g->path_scale[L->r_fib + i] = 1;  // lM / lopt: O(1)
+    g->path_lb[L->r_fib + i] = o->fibre_lo;
+    g->path_ub[L->r_fib + i] = o->fibre_hi;
+  }
 
   // boundary: periodic states (but pelvis_tx and free coordinates), excitations, speed
   unsigned char* periodic = (unsigned char*)zalloc((size_t)nz, 1);
@@ -1097,6 +1216,8 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   p.boundary_scale = g->bnd_scale;
   p.obj_scale = 1.0;
   p.path = path_cb;
+  p.path_lb = g->path_lb;
+  p.path_ub = g->path_ub;
   p.path_col_ptr = g->col_ptr;
   p.path_row_idx = g->row_idx;
   p.path_jac = path_jac_cb;

@@ -13,7 +13,7 @@
 // the others and is exact since the row is linear). We chose these rows over a deriv_idx map in
 // the engine because the engine is done and tested; they cost nv rows and 2 nv nonzeros per node.
 //
-// Path rows per node, [link (nv) | eom (nv) | hill (ne) | act (na) | grf (6)]:
+// Path rows per node, [link (nv) | eom (nv) | hill (ne) | act (na) | grf (6) | fibre (na)?]:
 //   link  qdot - q'                                                        (rad/s, m/s)
 //   eom   mj_inverse(q, qdot, qddot).qfrc_inverse + actuator_moment^T tension    (N m, N)
 //         (qfrc_inverse runs mjcb_passive: the foot contact; all nv rows, pelvis included: no
@@ -22,10 +22,16 @@
 //   hill  gs_muscle_equilibrium_residual(a, lMT, vMT, fT, fT') for each elastic muscle     (-)
 //   act   adot - gs_activation_dot(e, a)                                             (1/s)
 //   grf   grf - gs_physics_foot_grf(q, qdot).force, per foot                           (N)
+//   fibre (only with opts.fibre_bounds) fibre_lo <= lM / lopt <= fibre_hi for every muscle,
+//         default 0.25 and 1.5 (Lin, Walter & Pandy 2018, eq. 2's bounds on the normalised fibre
+//         length): lM = gs_muscle_fibre_length(lMT(q), lT) with lT = lts
+//         gs_muscle_ft_inverse(fT) for an elastic tendon, lT = lts for a rigid one          (-)
+//         Inequalities; off for tracking, on in `gaitsim predict` (--no-fibre-bounds).
 // Tension: elastic Fmax fT; rigid gs_muscle_rigid_force(a, lMT, vMT).
 //
 // Derivatives: analytic columns q' (-1), qddot (mass matrix M from mj_fullM after mj_inverse),
-// a (rigid: moment dF/da; act row), fT (moment Fmax; hill row), adot, fT', e, grf. Central
+// a (rigid: moment dF/da; act row), fT (moment Fmax; hill row; fibre row
+// -cos(alpha) lts dlT_norm/dfT / lopt), adot, fT', e, grf. Central
 // differences for the q and qdot columns only (2 nv colour groups, the eom rows being dense in
 // them). Pattern per node: eom rows dense in q and qdot; qddot columns of the eom rows where the
 // two dofs are on one branch of the kinematic tree (M's structure); a muscle's eom rows, and its
@@ -33,19 +39,23 @@
 // of the trial poses or at 64 random poses around them (+-0.35 rad, +-0.03 m on every
 // coordinate, fixed seed): the perturbations are the safety margin for moment arms that vanish at
 // some poses (wrapping). Grf rows: q and qdot of the dofs on the path from the world to the
-// foot's contact spheres.
+// foot's contact spheres. Fibre rows: the q columns of the dofs the muscle crosses and, elastic,
+// its fT column.
 //
 // Scaling (Ipopt sees O(1)): q 1, qdot and q' 5, qddot 50, a and e 1, adot 20, fT 1, fT' 10,
 // grf m g; rows: link 5, eom m g * 1 m (N m; N for slides), hill 1, act 20, grf m g; periodicity
-// rows as their variable, speed row 1 m/s; objective 1.
+// fibre 1 (lM / lopt is O(1)); rows as their variable, speed row 1 m/s; objective 1.
 //
 // Objective J = I / T, I = trapezoidal integral of (means over each group of terms)
 //   w_pelvis_rot ((q - q_meas)/5 deg)^2 + w_pelvis_trans ((q - q_meas)/2 cm)^2
 //   + w_joint ((q - q_meas)/(5 deg or 2 cm))^2 + w_grf ((grf - grf_meas)/(0.1 m g))^2
-//   + w_effort e^2
-// over the coordinates present in the measured table (pelvis: the dofs of the root body), with an
-// analytic gradient. Hook for the predictive problem: cost of transport (metabolic rate / (dx m))
-// would enter as another integrand term and outer(); not done here.
+//   + w_effort e^2 + w_accel (qddot / GO_GAIT_ACCEL_SCALE)^2
+// over the coordinates present in the measured table (pelvis: the dofs of the root body; accel:
+// every dof), with an analytic gradient and the exact diagonal Hessian (integrand_hess, for the
+// Gauss-Newton option). The acceleration term (issue #5) is a smoothness regularisation of the
+// predictive problem; its scale is qddot's variable scale below. With w_cot > 0 the integrand
+// gains w_cot Edot / (m V) (J = w_cot COT + ...; its gradient by finite differences, no
+// Hessian term). go_gait_objective_terms splits J into these goals.
 //
 // Boundary: periodicity of every state but pelvis_tx (and the coordinates named in free_coords),
 // and of the excitations; optionally mean speed (tx_last - tx_first) / T = speed.
@@ -65,6 +75,12 @@
 #include "optim/go_hessian.h"
 
 #define GO_GAIT_NGRF 6  // grf variables per node: right foot x y z, left foot x y z (world)
+#define GO_GAIT_ACCEL_SCALE 50.0  // s_j of the acceleration goal (rad/s^2, m/s^2): qddot's scale
+
+// goals of J (go_gait_objective_terms), in this order; names in GO_GAIT_TERM_NAMES
+enum { GO_GAIT_TERM_PELVIS, GO_GAIT_TERM_JOINTS, GO_GAIT_TERM_GRF, GO_GAIT_TERM_EFFORT,
+       GO_GAIT_TERM_COT, GO_GAIT_TERM_ACCEL, GO_GAIT_NTERMS };
+#define GO_GAIT_TERM_NAMES {"pelvis", "joints", "grf", "effort", "cot", "accel"}
 
 // Options of the gait problem; go_gait_opts_default fills them.
 typedef struct {
@@ -79,6 +95,8 @@ typedef struct {
   double w_joint;                   // weight of the other coordinates                    (-)
   double w_grf;                     // weight of ground reaction tracking                 (-)
   double w_effort;                  // weight of the mean squared excitation              (-)
+  double w_accel;                   // weight of the mean over all nv dofs of
+                                    // (qddot_j / GO_GAIT_ACCEL_SCALE)^2; 0: none         (-)
   int periodic;                     // 1: periodicity boundary rows
   const char* const* free_coords;   // NULL-terminated coordinates left out of periodicity
                                     // besides pelvis_tx (NULL: none)
@@ -92,6 +110,8 @@ typedef struct {
                                     // the band of eq. 3 is centred on (the tracking solution)
   const double* band_q;             // half-width per dof of the coordinate band (nv; <= 0: none)
   const double* band_qd;            // half-width per dof of the speed band (nv; <= 0: none)
+  int fibre_bounds;                 // 1: fibre path rows fibre_lo <= lM/lopt <= fibre_hi (eq. 2)
+  double fibre_lo, fibre_hi;        // bounds of the normalised fibre length lM / lopt     (-)
 } go_gait_opts;
 
 // Where everything sits in z_k and in the path rows of a node.
@@ -101,11 +121,12 @@ typedef struct {
   int ne;        // elastic-tendon muscles
   int nx;        // states, 2 nv + na + ne
   int nz;        // node variables, 2 nx + na + GO_GAIT_NGRF
-  int n_path;    // path rows, 2 nv + ne + na + GO_GAIT_NGRF
+  int n_path;    // path rows, 2 nv + ne + na + GO_GAIT_NGRF (+ na with fibre bounds)
   int x_q, x_qd, x_a, x_ft;        // offsets of q, qdot, a, fT in z_k
   int xd_q, xd_qdd, xd_a, xd_ft;   // offsets of q', qddot, adot, fT'
   int u_e, u_grf;                  // offsets of excitations and grf variables
   int r_link, r_eom, r_hill, r_act, r_grf;  // offsets of the path row blocks
+  int r_fib;                       // offset of the fibre rows (na), -1 without fibre bounds
   const int* elastic;              // actuator of elastic muscle e (ne)
   const int* elastic_of;           // elastic index of actuator i, -1 if rigid (na)
   int tx;                          // dof of pelvis_tx, -1 if none
@@ -114,8 +135,8 @@ typedef struct {
 typedef struct go_gait go_gait;
 
 // defaults: N 40, 1 thread, T from coords, w_pelvis_rot 1, w_pelvis_trans 1, w_joint 1, w_grf 1,
-// w_effort 0.1, periodic 1, no free coordinates, no speed constraint; no prediction (w_cot 0,
-// fixed time, no band)
+// w_effort 0.1, w_accel 0, periodic 1, no free coordinates, no speed constraint; no prediction
+// (w_cot 0, fixed time, no band, no fibre bounds; fibre_lo 0.25, fibre_hi 1.5)
 void go_gait_opts_default(go_gait_opts* opts);
 
 // Build the problem for model m (prepared by gs_physics_prepare; every actuator must be a gaitsim
@@ -148,6 +169,18 @@ double go_gait_time_of(const go_gait* g, const double* z);
 // muscles' smooth Umberger 2010 metabolic power over the stride divided by the body mass and the
 // pelvis_tx displacement (Lin, Walter & Pandy 2018, eq. 1). NAN without pelvis_tx.
 double go_gait_cot(const go_gait* g, const double* z);
+
+// Goals of J at the physical point z (N nz [+ 1]): terms[GO_GAIT_NTERMS] (order of the
+// GO_GAIT_TERM_* enum: pelvis rotation and translation tracking, other coordinates, grf, effort,
+// cost of transport (w_cot E / (m V T): w_cot COT when the speed row holds), acceleration), each
+// the trapezoidal integral of its part of the integrand over T, so they sum to J (the tracking
+// goals, whatever go_gait_set_proximal says).
+// 0, or -1 when a value is not finite.
+int go_gait_objective_terms(const go_gait* g, const double* z, double* terms);
+
+// Normalised fibre lengths lM / lopt (na, -) of node variables z_k (physical) as the fibre rows
+// compute them (with or without fibre bounds), d as scratch (go_gait_load_node runs).
+void go_gait_fibre_lengths(const go_gait* g, mjData* d, const double* z_k, double* lm_norm);
 
 // Feasibility polish: with z0 (N nz, physical; copied) the objective becomes the proximal term
 // sum_k w_k h sum_j ((z_kj - z0_kj) / z_scale_j)^2 / T instead of the tracking goals, so a solve

@@ -38,6 +38,13 @@ typedef struct {
   const int* rows;      // path rows (0 .. n_path-1)
   const int* var_ptr;   // variables of element e: vars[var_ptr[e] .. var_ptr[e+1]) (n_elem + 1)
   const int* vars;      // node variables (0 .. nz-1), strictly increasing within an element
+  // optional, for the finite-difference Hessian (go_hess_create_fd); NULL: none / all
+  const unsigned char* lin;  // per element variable (aligned with vars): 1 when the element's
+                             // rows are jointly linear in the variables so marked (no curvature
+                             // among them, e.g. the dynamics in qddot and the tendon forces)
+  const unsigned char* fd_pairs;  // nz x nz: 0 where two finite-difference (non-analytic)
+                                  // variables of one element are known to have no mixed curvature
+                                  // (e.g. dofs on different branches of the kinematic tree)
 } go_elements;
 
 typedef struct go_hess go_hess;
@@ -61,6 +68,28 @@ void go_hess_note_jacobian(go_hess* h, const double* x, const double* jac);
 // 0, or -1 when x's Jacobian was not noted or the objective diagonal failed.
 int go_hess_values(go_hess* h, const double* x, double obj_factor, const double* lambda,
                    double* vals);
+
+// Exact Hessian by finite differences instead of secant updates (the element structure decides
+// what is evaluated). With phi_k = sum_r lambda_{k,r} g_r(z_k) over the rows of the elements, in
+// the solver's scaling, per node:
+//   (A) pairs of finite-difference variables i, j (the columns without path_jac) sharing an element
+//       (and allowed by fd_pairs): second differences of phi_k,
+//       H_ii = (phi(+i) - 2 phi + phi(-i)) / h^2,  H_ij = (phi(+i+j) - phi(+i) - phi(+j) + phi) / h^2,
+//       h = 1e-4 max(1, |z~|) (eps^(1/4), balancing truncation against rounding), one path
+//       evaluation per pair and two per variable;
+//   (B) a finite-difference variable i with an analytic column w of one element: forward
+//       differences of the analytic partials (path_jac at z + h e_i, h = sqrt(eps) max(1, |z~|));
+//   (C) analytic variables with curvature in some element (not `lin` there): central differences
+//       of path_jac, the variables perturbed together in colour groups such that within any
+//       element a group holds at most one (distance-1 colouring of "share an element where one
+//       of them is not lin"); entries between two such variables averaged over both perturbations.
+// Costs per node and Hessian: 1 + 2 n_fd + n_pairs path evaluations, 1 + n_fd + 2 n_colours
+// path_jac calls (full body: 26 dofs -> n_fd 52; see docs/BENCHMARKS.md). The pattern holds only
+// the entries these produce (structural zeros of lin x lin left out) and every diagonal. The
+// objective adds its exact diagonal (go_nlp_eval_hess_diag) when the problem has one; otherwise
+// the objective's curvature is left out. With a free T the defects' T x xdot curvature is left out.
+// Rows in no element are taken as linear. Same arguments and results as go_hess_create.
+int go_hess_create_fd(go_hess** out, go_nlp* nlp, const go_elements* el, char* err, int errsz);
 
 // counters: element updates done and skipped (tiny, non-finite or ill-conditioned pairs)
 void go_hess_counts(const go_hess* h, long* updates, long* skipped);

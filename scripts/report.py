@@ -12,7 +12,10 @@ coordinates.mot, grf.mot, trial.json, knee_contact.sto):
 - grf.png: fore-aft, vertical, mediolateral GRF per foot in body weights, model vs measured (the
   measured GRF times summary.json "grf_scale", the factor tracking applied, when present);
 - knee_contact.png (when DIR has knee_contact.sto): right-knee total, medial, lateral contact
-  force in BW, model vs measured (whichever of those columns exist);
+  force in BW, model vs measured (whichever of those columns exist); beside them, when the file
+  has contact_total_l, the left (1-DOF) knee's compressive joint reaction with the right knee's
+  model and measured curves shifted to the left heel strike for comparison (cf. Fig. 8: the
+  in-vivo data are for the right, implant knee only);
 - excitations.png: right-leg model excitations (controls.sto) against the EMG envelopes of
   mjmodels/reference/healthy_emg.csv (Falisse et al. 2019, a different, healthy subject), each
   normalised to its peak over the cycle: timing only;
@@ -223,6 +226,23 @@ def knee_series(st):
     return series
 
 
+def heel_strike_pct(st, label, threshold=20.0):
+    """% gait cycle of the first rise of st's column label (N) through threshold (N), linearly
+    interpolated; None when it never rises through it."""
+    f = st.col(label)
+    for i in range(1, len(f)):
+        if f[i - 1] < threshold <= f[i]:
+            w = (threshold - f[i - 1]) / (f[i] - f[i - 1])
+            return float(st.pct[i - 1] + w * (st.pct[i] - st.pct[i - 1]))
+    return None
+
+
+def shifted(pct, values, shift):
+    """A periodic curve over % gait cycle delayed by shift (%): (pct, values at pct - shift)."""
+    import numpy as np
+    return pct, np.interp((pct - shift) % 100.0, pct, values, period=100.0)
+
+
 def load(args):
     """Read and check every input; returns a dict of everything the figures need."""
     sol = args.dir
@@ -273,6 +293,9 @@ def load(args):
         d["knee_model"] = {k: v / d["bw"] for k, v in knee_series(d["knee"]).items()}
         d["knee_meas"] = ({k: v / d["bw"] for k, v in knee_series(d["meas_knee"]).items()}
                           if d["meas_knee"] is not None else {})
+        d["knee_left"] = (d["knee"].col("contact_total_l") / d["bw"]
+                          if d["knee"].has("contact_total_l") else None)
+        d["left_strike_pct"] = heel_strike_pct(d["meas_grf"], "ground_force_l_vy")
     d["emg"] = []
     d["emg_skipped"] = []
     for ch, muscles, pct, mean, std in read_emg(EMG_PATH):
@@ -341,9 +364,31 @@ def fig_grf(d, plt):
 
 def fig_knee(d, plt):
     parts = [p for p in ("total", "medial", "lateral") if p in d["knee_model"] or p in d["knee_meas"]]
-    fig, axes = plt.subplots(1, len(parts), figsize=(3.4 * len(parts), 3.2), layout="constrained",
+    left = d.get("knee_left") is not None
+    npanel = len(parts) + left
+    fig, axes = plt.subplots(1, npanel, figsize=(3.4 * npanel, 3.2), layout="constrained",
                              squeeze=False)
-    for ax, part in zip(axes[0], parts):
+    left_at = 1 if "total" in parts else 0  # the left knee's panel: right after the right total
+    if left:
+        # the left knee beside the right total: left over the right's cycle, the right knee's
+        # curves delayed to the left heel strike (measured GRF) so that the stances line up
+        ax = axes[0][left_at]
+        shift = d["left_strike_pct"]
+        if shift is not None:
+            for name, st, series, style in (
+                    ("measured right (eTibia)", d["meas_knee"], d["knee_meas"], "--"),
+                    ("model right", d["knee"], d["knee_model"], ":")):
+                if st is not None and "total" in series:
+                    x, y = shifted(st.pct, series["total"], shift)
+                    ax.plot(x, y, color="0.2" if style == "--" else "tab:purple", linestyle=style,
+                            linewidth=1.0, label=f"{name}, +{shift:.0f} %")
+        ax.plot(d["knee"].pct, d["knee_left"], color="tab:green", linewidth=1.2,
+                label="model left (joint reaction)")
+        ax.set_title("left knee (1-DOF), total compressive", fontsize=8)
+        panel_style(ax, "% gait cycle", "BW")
+        ax.legend(fontsize=6, loc="best")
+    panel_axes = [a for k, a in enumerate(axes[0]) if not (left and k == left_at)]
+    for ax, part in zip(panel_axes, parts):
         if part in d["knee_meas"]:
             ax.plot(d["meas_knee"].pct, d["knee_meas"][part], color="0.2", linestyle="--",
                     linewidth=1.2, label="measured (eTibia)")
@@ -436,7 +481,12 @@ def report_md(d, figures):
                       f"; the measured GRF is scaled by grf_scale = {d['grf_scale']:.4f}, the factor "
                       "the tracking solve applied so that its stride mean equals the model's weight."),
         "knee_contact.png": "Right-knee contact force (total, medial, lateral) in BW, model vs "
-                            "measured eTibia (cf. Fig. 3).",
+                            "measured eTibia (cf. Fig. 3)"
+                            + ("." if d.get("knee_left") is None else
+                               "; left (1-DOF) knee: compressive joint reaction along the tibia, "
+                               "with the right knee's curves delayed to the left heel strike for "
+                               "comparison (cf. Fig. 8; in-vivo data exist for the right knee "
+                               "only)."),
         "excitations.png": "Right-leg excitations vs EMG envelopes of a healthy subject (Falisse et "
                            "al. 2019), each normalised to its peak: timing only.",
     }

@@ -2,15 +2,22 @@
 // the engine's Jacobian (analytic columns: mass matrix, moment arms x muscle partials, Hill and
 // activation partials; finite differences for q, qdot) against dense central differences of the
 // whole constraint vector, every nonzero inside the declared pattern, the objective gradient,
-// bitwise equality with 1 and 2 threads, and the guess satisfying its exact rows.
+// bitwise equality with 1 and 2 threads, and the guess satisfying its exact rows. The problem
+// checked carries the predictive extras too: the acceleration goal (w_accel 2) and the fibre
+// rows 0.25 <= lM/lopt <= 1.5 (their q and fT columns inside the pattern, FD agreement); the
+// Gauss-Newton Hessian diagonal against differences of the gradient; the objective's goals
+// (go_gait_objective_terms) summing to J; the fibre rows equal to the muscle model's own fibre
+// length (gs_physics_muscle_tension).
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
 
 #include "app/gs_app_model.h"
+#include "callbacks/gs_physics.h"
 #include "optim/go_gait.h"
 #include "optim/go_gait_guess.h"
+#include "optim/go_hessian.h"
 #include "optim/go_jacobian.h"
 #include "tests/gs_test.h"
 #include "tests/gs_test_nlp.h"
@@ -23,10 +30,16 @@ static double now(void) {
   return ts.tv_sec + 1e-9 * ts.tv_nsec;
 }
 
-static go_gait* make(const mjModel* m, const gsTable* coords, const gsTable* grf, int nthreads) {
+#define W_ACCEL 2.0
+
+// extras: the acceleration goal and the fibre-length rows
+static go_gait* make(const mjModel* m, const gsTable* coords, const gsTable* grf, int nthreads,
+                     int extras) {
   go_gait_opts o;
   go_gait_opts_default(&o);
   o.N = 4;
+  o.w_accel = extras ? W_ACCEL : 0;
+  o.fibre_bounds = extras;
   o.nthreads = nthreads;
   o.coords = coords;
   o.grf = grf;
@@ -48,15 +61,46 @@ int main(void) {
   if (!m) return GS_TEST_RESULT();
   EXPECT_EQ_INT(0, gs_app_read_table(m, TRIAL "/coordinates.mot", &coords));
   EXPECT_EQ_INT(0, gs_app_read_table(m, TRIAL "/grf.mot", &grf));
-  go_gait* g1 = make(m, &coords, &grf, 1);
-  go_gait* g2 = make(m, &coords, &grf, 2);
-  EXPECT_TRUE(g1 && g2);
-  if (!(g1 && g2)) return GS_TEST_RESULT();
+  go_gait* g0 = make(m, &coords, &grf, 1, 0);  // the tracking problem as it was
+  go_gait* g1 = make(m, &coords, &grf, 1, 1);
+  go_gait* g2 = make(m, &coords, &grf, 2, 1);
+  EXPECT_TRUE(g0 && g1 && g2);
+  if (!(g0 && g1 && g2)) return GS_TEST_RESULT();
   const go_gait_layout* L = go_gait_layout_get(g1);
+  const go_gait_layout* L0 = go_gait_layout_get(g0);
   go_nlp* a = go_gait_nlp(g1);
   go_nlp* b = go_gait_nlp(g2);
   int n, mm, ne;
   go_nlp_sizes(a, &n, &mm, &ne);
+  // the fibre rows: na more rows per node, after the grf rows, nonzero only in q columns and
+  // the muscle's own fT column (which every elastic muscle's row has)
+  {
+    int n0, m0, ne0, bad_col = 0, ft_cols = 0, fib_nnz = 0;
+    go_nlp_sizes(go_gait_nlp(g0), &n0, &m0, &ne0);
+    EXPECT_EQ_INT(-1, L0->r_fib);
+    EXPECT_EQ_INT(L0->n_path, L->r_fib);
+    EXPECT_EQ_INT(L0->n_path + L->na, L->n_path);
+    EXPECT_EQ_INT(n0, n);
+    EXPECT_EQ_INT(m0 + 4 * L->na, mm);
+    int* ir0 = malloc(sizeof(int) * (size_t)ne);
+    int* jc0 = malloc(sizeof(int) * (size_t)ne);
+    go_nlp_jac_structure(a, ir0, jc0);
+    for (int e = 0; e < ne; e++) {
+      int row = ir0[e] - go_nlp_row_path(a, 0, 0);
+      if (row < 0 || row >= 4 * L->n_path || row % L->n_path < L->r_fib) continue;
+      int i = row % L->n_path - L->r_fib, v = jc0[e] % L->nz;
+      fib_nnz++;
+      if (L->elastic_of[i] >= 0 && v == L->x_ft + L->elastic_of[i]) ft_cols++;
+      else if (!(v >= L->x_q && v < L->x_q + L->nv)) bad_col++;
+    }
+    EXPECT_EQ_INT(0, bad_col);
+    EXPECT_EQ_INT(4 * L->ne, ft_cols);
+    EXPECT_EQ_INT(ne0 + fib_nnz, ne);
+    printf("fibre rows: %d muscles (%d elastic), %d nonzeros per node\n", L->na, L->ne,
+           fib_nnz / 4);
+    free(ir0);
+    free(jc0);
+  }
   printf("gait N=4: nz %d, n %d, m %d, nele_jac %d, path rows/node %d, groups %d\n", L->nz, n, mm,
          ne, L->n_path, go_nlp_path_groups(a));
   EXPECT_EQ_INT(2 * L->nv, go_nlp_path_groups(a));
@@ -78,6 +122,30 @@ int main(void) {
   EXPECT_NEAR(0, link, 1e-12);
   EXPECT_NEAR(0, grfr, 1e-12);
   EXPECT_NEAR(0, act, 1e-12);
+  // fibre rows (scale 1) are the muscle model's own lM / lopt: elastic tendons from the fT state
+  // through the forward model's fibre kinematics, rigid ones from lts
+  {
+    const mjModel* gm = go_gait_model(g1);
+    mjData* d = mj_makeData(gm);
+    double worst_fib = 0, lo = 1e9, hi = -1e9;
+    int outside = 0;
+    for (int k = 0; k < 4; k++) {
+      go_gait_load_node(g1, d, z + (size_t)k * L->nz);
+      for (int i = 0; i < L->na; i++) {
+        gsMuscleOut out;
+        gs_physics_muscle_tension(gm, d, i, &out);
+        double row = g[go_nlp_row_path(a, k, L->r_fib + i)];
+        worst_fib = fmax(worst_fib, fabs(row - out.lM_norm));
+        lo = fmin(lo, row), hi = fmax(hi, row);
+        outside += row < 0.25 || row > 1.5;
+      }
+    }
+    printf("fibre rows at the trial guess: lM/lopt in [%.3f, %.3f], %d of %d outside [0.25, 1.5], "
+           "largest difference from gs_physics_muscle_tension %.1e\n", lo, hi, outside,
+           4 * L->na, worst_fib);
+    EXPECT_NEAR(0, worst_fib, 1e-12);
+    mj_deleteData(d);
+  }
 
   // a deterministic point around the guess, muscles active and tendons moving
   srand(11);
@@ -127,13 +195,19 @@ int main(void) {
   gs_test_dense_fd(a, zs, mm, n, D, Dg);
   unsigned char* inpat = calloc((size_t)mm * (size_t)n, 1);
   int bad_val = 0, bad_out = 0;
-  double worst = 0;
+  double worst = 0, worst_fib = 0;
+  int n_fib = 0;
   for (int e = 0; e < ne; e++) {
     double ex = D[(size_t)ir[e] * n + jc[e]];
     inpat[(size_t)ir[e] * n + jc[e]] = 1;
     double rel = fabs(ex) > 1e-6 ? fabs(J[e] - ex) / fabs(ex) : fabs(J[e] - ex);
     double tol = fabs(ex) > 1e-6 ? 1e-4 : 1e-7;
     if (fabs(ex) > 1e-6 && rel > worst) worst = rel;
+    int prow = ir[e] - go_nlp_row_path(a, 0, 0);
+    if (prow >= 0 && prow < 4 * L->n_path && prow % L->n_path >= L->r_fib) {
+      n_fib++;
+      if (fabs(ex) > 1e-6 && rel > worst_fib) worst_fib = rel;
+    }
     if (rel > tol && bad_val++ < 8) {
       int node = jc[e] / L->nz;
       fprintf(stderr, "jac entry %d (row %d, col %d = node %d var %d): expected %.10g actual %.10g\n",
@@ -157,7 +231,8 @@ int main(void) {
   EXPECT_EQ_INT(0, bad_val);
   EXPECT_EQ_INT(0, bad_out);
   printf("jacobian: %d entries, worst relative error %.2e, largest dense FD value outside the "
-         "pattern %.1e\n", ne, worst, worst_out);
+         "pattern %.1e; fibre rows: %d entries, worst relative error %.2e\n", ne, worst, worst_out,
+         n_fib, worst_fib);
   int bad_grad = 0;
   for (int v = 0; v < n; v++) {
     double ex = Dg[v];
@@ -167,6 +242,95 @@ int main(void) {
       fprintf(stderr, "grad %d: expected %.10g actual %.10g\n", v, ex, grad[v]);
   }
   EXPECT_EQ_INT(0, bad_grad);
+
+  // Gauss-Newton Hessian: without cost of transport the integrand is a sum of squares of single
+  // variables (tracking, effort, acceleration), so the diagonal is exact: against central
+  // differences of the analytic gradient, step 1e-4 (scaled), relative 1e-4 with floor 1e-6 (the
+  // collocation test's rule); the qddot entries carry the acceleration goal and are nonzero.
+  {
+    double* H = malloc(sizeof(double) * (size_t)n);
+    double* gp = malloc(sizeof(double) * (size_t)n);
+    double* gm = malloc(sizeof(double) * (size_t)n);
+    EXPECT_EQ_INT(1, go_nlp_has_hess_diag(a));
+    EXPECT_EQ_INT(0, go_nlp_eval_hess_diag(a, zs, 0.5, H));
+    int bad_h = 0;
+    double worst_h = 0, accel_h = 0;
+    for (int v = 0; v < n; v++) {
+      double x0 = zs[v], hstep = 1e-4;
+      zs[v] = x0 + hstep;
+      go_nlp_eval_grad_f(a, zs, gp);
+      zs[v] = x0 - hstep;
+      go_nlp_eval_grad_f(a, zs, gm);
+      zs[v] = x0;
+      double ex = 0.5 * (gp[v] - gm[v]) / (2 * hstep);
+      double rel = fabs(H[v] - ex) / fmax(fabs(ex), 1e-6);
+      if (fabs(ex) > 1e-6) worst_h = fmax(worst_h, rel);
+      int var = v % L->nz;
+      if (var >= L->xd_qdd && var < L->xd_qdd + L->nv) accel_h = fmax(accel_h, H[v]);
+      if (rel > 1e-4 && bad_h++ < 5)
+        fprintf(stderr, "hess diag %d (var %d): expected %.10g actual %.10g\n", v, var, ex, H[v]);
+    }
+    EXPECT_EQ_INT(0, bad_h);
+    EXPECT_TRUE(accel_h > 1e-6);
+    printf("gauss-newton diagonal: worst relative error %.2e; largest qddot entry %.3g\n", worst_h,
+           accel_h);
+    free(H);
+    free(gp);
+    free(gm);
+  }
+
+  // the goals sum to J; the acceleration goal is its definition: the trapezoid over T of
+  // W_ACCEL mean_j (qddot_j / 50)^2
+  {
+    double terms[GO_GAIT_NTERMS], sum = 0, acc = 0, T = go_gait_time_of(g1, z), h = T / 3, fq;
+    double* zq = malloc(sizeof(double) * (size_t)n);  // q off the measured ones: tracking > 0
+    memcpy(zq, z, sizeof(double) * (size_t)n);
+    for (int k = 0; k < 4; k++)
+      for (int j = 0; j < L->nv; j++) zq[(size_t)k * L->nz + L->x_q + j] += 0.01 * (j % 3 - 1);
+    go_nlp_scale_z(a, zq, zs);
+    EXPECT_EQ_INT(0, go_nlp_eval_f(a, zs, &fq));
+    go_nlp_scale_z(a, z, zs);
+    EXPECT_EQ_INT(0, go_gait_objective_terms(g1, zq, terms));
+    free(zq);
+    for (int t = 0; t < GO_GAIT_NTERMS; t++) sum += terms[t];
+    for (int k = 0; k < 4; k++) {
+      double s2 = 0;
+      for (int j = 0; j < L->nv; j++) s2 += pow(z[(size_t)k * L->nz + L->xd_qdd + j] / 50.0, 2);
+      acc += (k == 0 || k == 3 ? 0.5 : 1.0) * h * W_ACCEL * s2 / L->nv / T;
+    }
+    double Jphys = go_nlp_objective_phys(a, fq);
+    static const char* names[GO_GAIT_NTERMS] = GO_GAIT_TERM_NAMES;
+    printf("objective %.6g =", Jphys);
+    for (int t = 0; t < GO_GAIT_NTERMS; t++) printf(" %s %.4g", names[t], terms[t]);
+    printf("\n");
+    EXPECT_REL(Jphys, sum, 1e-12, 1e-14);
+    EXPECT_REL(acc, terms[GO_GAIT_TERM_ACCEL], 1e-12, 1e-14);
+    EXPECT_TRUE(terms[GO_GAIT_TERM_PELVIS] > 0 && terms[GO_GAIT_TERM_JOINTS] > 0 &&
+                terms[GO_GAIT_TERM_GRF] > 0 && terms[GO_GAIT_TERM_EFFORT] > 0 &&
+                terms[GO_GAIT_TERM_ACCEL] > 0);
+    EXPECT_NEAR(0, terms[GO_GAIT_TERM_COT], 0);
+    // with a cost-of-transport goal (its integrand w_cot Edot / (m V)) the goals still sum to J
+    go_gait_opts o;
+    go_gait_opts_default(&o);
+    o.N = 4;
+    o.coords = &coords;
+    o.speed = 1.27;
+    o.w_cot = 1.0;
+    o.w_accel = W_ACCEL;
+    go_gait* gc = NULL;
+    EXPECT_EQ_INT(0, go_gait_create(&gc, m, &o, err, sizeof(err)));
+    if (gc) {
+      double fc, tc[GO_GAIT_NTERMS], sc = 0;
+      go_nlp_scale_z(go_gait_nlp(gc), z, zs);
+      EXPECT_EQ_INT(0, go_nlp_eval_f(go_gait_nlp(gc), zs, &fc));
+      EXPECT_EQ_INT(0, go_gait_objective_terms(gc, z, tc));
+      for (int t = 0; t < GO_GAIT_NTERMS; t++) sc += tc[t];
+      EXPECT_REL(go_nlp_objective_phys(go_gait_nlp(gc), fc), sc, 1e-12, 1e-14);
+      EXPECT_TRUE(tc[GO_GAIT_TERM_COT] > 0 && tc[GO_GAIT_TERM_GRF] == 0);
+      go_nlp_scale_z(a, z, zs);
+      go_gait_free(gc);
+    }
+  }
 
   // 1 and 2 threads: bitwise identical
   double* J2 = malloc(sizeof(double) * (size_t)ne);
@@ -185,6 +349,19 @@ int main(void) {
     EXPECT_TRUE(memcmp(&f, &f2, sizeof(double)) == 0);
   }
 
+  // the partitioned quasi-Newton Hessian accepts the elements (fibre rows: rigid muscles in the
+  // dynamics element, elastic ones in their tendon element, every fibre row in exactly one)
+  {
+    const go_elements* el = go_gait_elements(g1);
+    int fib_rows = 0;
+    for (int q = 0; q < el->row_ptr[el->n_elem]; q++) fib_rows += el->rows[q] >= L->r_fib;
+    EXPECT_EQ_INT(L->na, fib_rows);
+    go_hess* hs = NULL;
+    EXPECT_EQ_INT(0, go_hess_create(&hs, a, el, err, sizeof(err)));
+    go_hess_free(hs);
+  }
+
+  go_gait_free(g0);
   go_gait_free(g1);
   go_gait_free(g2);
   gs_table_free(&coords);

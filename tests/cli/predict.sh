@@ -2,8 +2,9 @@
 # gaitsim predict end to end on a tiny problem: the fixture solution (tests/fixtures/solution_small)
 # as the guess, 5 nodes, 3 Ipopt iterations; the solve stops short (exit 3), the best iterate is
 # polished towards the dynamics (violation down 10-fold from the guess's; from this far the
-# polish does not reach feasibility), every file is written
-# and summary.json carries the prediction figures; bad usage exits 2, a missing guess exits 1
+# polish does not reach feasibility), every file is written (metabolics.sto: the muscles and
+# their total; knee_contact.sto: both knees) and summary.json carries the prediction figures and
+# the peak knee contact of both knees; bad usage exits 2, a missing guess exits 1
 # with one line naming the file.
 # usage: predict.sh GAITSIM SOURCE_DIR
 set -u
@@ -14,9 +15,28 @@ source "$(dirname "$0")/../cli_common.bash"
   --nodes 5 --max-iter 3 --threads 1 >/dev/null 2>log.txt
 status=$?
 check "stopped short: exit 3 (got $status)" test "$status" -eq 3
-for f in states.sto controls.sto grf.mot muscle_forces.sto knee_contact.sto summary.json; do
+for f in states.sto controls.sto grf.mot muscle_forces.sto metabolics.sto knee_contact.sto \
+    summary.json; do
   check "wrote $f" test -s "pred/$f"
 done
+# metabolics.sto: the muscles of muscle_forces.sto (W) and their sum, "total", at every node;
+# knee_contact.sto has the left knee's joint reaction beside the right knee's columns
+check "metabolics.sto: muscle columns and their total" /usr/bin/python3 - "$src/scripts" pred <<'PY'
+import math, os, sys
+sys.path.insert(0, sys.argv[1])
+from gs_scriptlib import read_storage
+_, mlab, mrows = read_storage(os.path.join(sys.argv[2], "metabolics.sto"))
+_, flab, frows = read_storage(os.path.join(sys.argv[2], "muscle_forces.sto"))
+_, klab, _ = read_storage(os.path.join(sys.argv[2], "knee_contact.sto"))
+ok = mlab == flab + ["total"] and len(mrows) == len(frows) == 5 and "contact_total_l" in klab
+for row in mrows:
+    parts = row[1:-1]
+    ok = ok and all(math.isfinite(v) for v in parts)
+    ok = ok and abs(row[-1] - sum(parts)) <= 1e-9 * max(1.0, abs(row[-1]))
+if not ok:
+    print("labels", mlab[:3], "...", mlab[-2:], "knee", klab, "rows", len(mrows), file=sys.stderr)
+sys.exit(0 if ok else 1)
+PY
 check "summary figures" /usr/bin/python3 - pred/summary.json <<'PY'
 import json, math, sys
 s = json.load(open(sys.argv[1]))
@@ -25,7 +45,10 @@ ok = (s["problem"] == "prediction" and s["speed_target_mps"] == 0.8
       and abs(s["stride_length_m"] / s["stride_time_s"] - 0.8) < 1e-4   # the speed row holds
       and s["max_violation"] * 10 <= s["initial_violation"]
       and math.isfinite(s["cost_of_transport_j_per_kg_m"]) and s["cost_of_transport_j_per_kg_m"] > 0
-      and s["polish"]["used"] and set(s["peak_excitation"]) >= {"soleus", "gasmed"})
+      and s["polish"]["used"] and set(s["peak_excitation"]) >= {"soleus", "gasmed"}
+      and all(s[f"peak_knee_contact_{k}_n"] > 0
+              and abs(s[f"peak_knee_contact_{k}_bw"] * s["body_weight_n"]
+                      - s[f"peak_knee_contact_{k}_n"]) < 1e-6 for k in "rl"))
 if not ok:
     print(json.dumps(s, indent=1), file=sys.stderr)
 sys.exit(0 if ok else 1)

@@ -64,6 +64,18 @@ check "links the figures" test "$(grep -c '^!\[.*\](\(kinematics\|grf\|knee_cont
 check "caption names the GRF scale" grep -q 'grf_scale = 0.9510' $md
 check "no temporary files left" test -z "$(ls -A sol/report | grep -v '^\(report\.md\|[a-z_]*\.png\)$')"
 
+# a left-knee column (contact_total_l) adds the left knee's panel beside the right's
+cp -r sol left && rm -rf left/report
+awk 'f == 1 {$0 = $0 "\tcontact_total_l"; f = 2} f == 2 && !/contact_total_l/ {$0 = $0 "\t" 700 + NR}
+     /^nColumns=/ {$0 = "nColumns=5"} /^endheader/ {f = 1} {print}' \
+  sol/knee_contact.sto >left/knee_contact.sto
+"$gaitsim" report left >/dev/null
+check "left knee: report exits 0" test $? -eq 0
+w3=$(png_info sol/report/knee_contact.png) w4=$(png_info left/report/knee_contact.png)
+w3=${w3#ok } w4=${w4#ok }
+check "left knee: one more panel ($w3 -> $w4)" test "${w4%x*}" = "$(( ${w3%x*} * 4 / 3 ))"
+check "left knee: caption" grep -q 'left (1-DOF) knee: compressive joint reaction' left/report/report.md
+
 # --out elsewhere; without knee_contact.sto there is no knee figure
 cp -r sol noknee && rm -rf noknee/report noknee/knee_contact.sto
 "$gaitsim" report noknee --out elsewhere >/dev/null

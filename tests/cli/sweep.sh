@@ -2,7 +2,8 @@
 # gaitsim sweep on a tiny problem: the fixture solution (given a speed of 1.27 m/s) as the guess,
 # speeds 0.9 (below: the downward chain, in the forked process) and 1.6 (upward chain), 5 nodes,
 # 2 Ipopt iterations each; exit 3 (solves stopped short), one folder per speed with its target
-# speed and log, a table with one row per speed in ascending order; a malformed list exits 2.
+# speed and log, a table with one row per speed in ascending order and the peak knee contact of
+# both knees; a malformed list exits 2.
 # usage: sweep.sh GAITSIM SOURCE_DIR
 set -u
 gaitsim=$1 src=$2
@@ -24,6 +25,14 @@ done
 check "csv: header and two rows" test "$(wc -l < sw/sweep.csv)" -eq 3
 check "csv rows ascending" test "$(cut -d, -f1 sw/sweep.csv | tail -n 2 | tr '\n' ' ')" = "0.9 1.6 "
 check "markdown table" grep -q '^| 1.6 |' sw/sweep.md
+check "peak knee contact of both knees, finite and > 0" /usr/bin/python3 - sw/sweep.csv <<'PY'
+import csv, math, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+ok = len(rows) == 2 and all(math.isfinite(float(r[k])) and float(r[k]) > 0
+                            for r in rows for k in ("peak_knee_contact_r_bw", "peak_knee_contact_l_bw"))
+sys.exit(0 if ok else 1)
+PY
+check "markdown: left knee column" grep -q '| peak knee contact, left (BW) |' sw/sweep.md
 "$gaitsim" sweep --guess guess --speeds 0.8:x:2 --out sw2 >/dev/null 2>&1
 check "malformed speeds: exit 2" test $? -eq 2
 finish

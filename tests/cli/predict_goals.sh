@@ -1,0 +1,53 @@
+#!/usr/bin/env bash
+# gaitsim predict's goals and fibre bounds on the fixture guess (tests/fixtures/solution_small),
+# 5 nodes, 0 Ipopt iterations, no polish (under a second each): summary.json's objective_terms
+# sum to the objective and objective_share to 1, the tracking goals are 0; the fibre-length
+# bounds 0.25 <= lM/lopt <= 1.5 are on by default (the guess's count outside them printed, a
+# fibre block in the violation lines) and --no-fibre-bounds removes their 93 x 5 rows; the accel
+# weight parses for track and predict, a negative one is bad usage (exit 2).
+# usage: predict_goals.sh GAITSIM SOURCE_DIR
+set -u
+gaitsim=$1 src=$2
+source "$(dirname "$0")/../cli_common.bash"
+guess="$src/tests/fixtures/solution_small"
+
+"$gaitsim" predict --guess "$guess" --speed 0.8 --out on --nodes 5 --max-iter 0 --no-polish \
+  --threads 1 >/dev/null 2>on.txt
+status=$?
+check "default: exit 3 at 0 iterations (got $status)" test "$status" -eq 3
+check "goal terms and shares" /usr/bin/python3 - on/summary.json <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+t, sh = s["objective_terms"], s["objective_share"]
+keys = {"pelvis", "joints", "grf", "effort", "cot", "accel"}
+ok = (set(t) == keys and set(sh) == keys and abs(sum(sh.values()) - 1) < 1e-9
+      and abs(sum(t.values()) - s["objective"]) <= 1e-9 * s["objective"]
+      and t["pelvis"] == t["joints"] == t["grf"] == 0 and t["cot"] > 0 and t["effort"] > 0
+      and t["accel"] >= 0)
+if not ok:
+    print(json.dumps({"objective": s["objective"], "terms": t, "share": sh}), file=sys.stderr)
+sys.exit(0 if ok else 1)
+PY
+check "guess checked against the fibre bounds" \
+  grep -q "guess: [0-9]* of 93 muscles outside 0.25 <= lM/lopt <= 1.5" on.txt
+check "fibre block in the violation lines" grep -q "initial violation by block:.* fibre " on.txt
+
+"$gaitsim" predict --guess "$guess" --speed 0.8 --out off --nodes 5 --max-iter 0 --no-polish \
+  --threads 1 --no-fibre-bounds --weight accel=0 >/dev/null 2>off.txt
+status=$?
+check "--no-fibre-bounds: exit 3 (got $status)" test "$status" -eq 3
+c1=$(sed -n 's/.*variables, \([0-9]*\) constraints.*/\1/p' on.txt)
+c2=$(sed -n 's/.*variables, \([0-9]*\) constraints.*/\1/p' off.txt)
+check "--no-fibre-bounds: 465 fewer constraints (${c1:-?} vs ${c2:-?})" \
+  test "$((${c1:-0} - ${c2:-0}))" -eq 465
+check "--no-fibre-bounds: no fibre block" bash -c "! grep -q ' fibre ' off.txt"
+check "accel=0: no acceleration goal" /usr/bin/python3 -c "import json, sys
+sys.exit(0 if json.load(open('off/summary.json'))['objective_terms']['accel'] == 0 else 1)"
+
+"$gaitsim" predict --guess "$guess" --speed 0.8 --out x --weight accel=-1 >/dev/null 2>&1
+check "predict --weight accel=-1: usage, exit 2" test $? -eq 2
+"$gaitsim" track nowhere --out x --weight accel=-1 >/dev/null 2>&1
+check "track --weight accel=-1: usage, exit 2" test $? -eq 2
+"$gaitsim" track nowhere --out x --weight accel=1 >/dev/null 2>&1
+check "track --weight accel=1 parses (missing trial: exit 1)" test $? -eq 1
+finish

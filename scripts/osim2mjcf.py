@@ -86,6 +86,11 @@ OVERSTRETCH_TOL = 0.03
 # largest normalised fibre length (tendon at slack) allowed anywhere in the trial
 # (cap_fibre_stretch)
 LM_MAX_TRIAL = 1.3
+# smallest normalised fibre length (tendon at slack) allowed anywhere in the trial, and the
+# longest that raising it may cause (the predictive problem's bound, Lin, Walter & Pandy 2018)
+# (floor_fibre_shortening)
+LM_MIN_TRIAL = 0.4
+LM_MAX_HARD = 1.5
 MUSCLE_DENSITY = 1059.7   # kg/m^3 (Umberger et al. 2003)
 VMAX = 10.0               # lopt/s
 TAU_ACT = 0.010           # s
@@ -1011,6 +1016,40 @@ def cap_fibre_stretch(model, frames):
     return changes
 
 
+def floor_fibre_shortening(model, frames):
+    """Shorten any tendon whose muscle would need a fibre shorter than LM_MIN_TRIAL optimal fibre
+    lengths somewhere in the trial (tendon at slack, as cap_fibre_stretch), so that its shortest
+    fibre is LM_MIN_TRIAL, or as close as the longest fibre allows without exceeding LM_MAX_HARD:
+        target = min(LM_MIN_TRIAL, LM_MAX_HARD - (L_max - L_min) / lopt)   (straight paths),
+        lts = L_min - sqrt((target lopt)^2 - (lopt sin alpha0)^2).
+    Why: where the muscle-tendon unit is shorter than its slack tendon plus a short fibre, the
+    Hill equilibrium (De Groote et al. 2016) has no tendon force to hold and a fibre on the
+    vanishing end of its force-length curve: the residual's derivatives vanish, its multipliers
+    grow without bound and Ipopt stalls (measured: JW's right semimembranosus, lts 0.378 m, is
+    longer than the whole path at the shortest trial pose, lM/lopt -0.56; the tracking solves at
+    N = 80 diverged with the largest multiplier on its row). Applied after cap_fibre_stretch.
+    Returns [(name, shortest lM/lopt before, old lts, new lts)] for the changed muscles."""
+    poses = [pose for _, pose in frames[::2]]
+    changes = []
+    for mus in model.muscles:
+        lopt, lts = mus["lopt"], mus["lts"]
+        height = lopt * math.sin(mus["pennation"])
+        lengths = [path_length(model, mus, pose) for pose in poses]
+        shortest, longest = min(lengths), max(lengths)
+        x = shortest - lts
+        before = math.copysign(math.sqrt(x * x + height * height), x) / lopt
+        if before >= LM_MIN_TRIAL:
+            continue
+        target = min(LM_MIN_TRIAL, LM_MAX_HARD - (longest - shortest) / lopt)
+        if target * lopt <= height or target <= before:
+            continue
+        new = shortest - math.sqrt((target * lopt) ** 2 - height ** 2)
+        changes.append((mus["name"], before, lts, new))
+        mus.setdefault("lts_osim", lts)
+        mus["lts"] = new
+    return changes
+
+
 def metabolic_key(name):
     """JW muscle name -> row of the 3dpredictsim table (right-leg rows serve both legs)."""
     if name in ("ercspn_r", "ercspn_l", "intobl_r", "intobl_l", "extobl_r", "extobl_l"):
@@ -1480,6 +1519,9 @@ def main():
     for name, stretch, old, new in cap_fibre_stretch(model, frames):
         print("lts %-11s lM/lopt max %.3f: %.4f -> %.4f m (%+.1f %%)" % (
             name, stretch, old, new, 100.0 * (new / old - 1.0)))
+    for name, short, old, new in floor_fibre_shortening(model, frames):
+        print("lts %-11s lM/lopt min %.3f: %.4f -> %.4f m (%+.1f %%)" % (
+            name, short, old, new, 100.0 * (new / old - 1.0)))
     conv = Converter(model, metabolic, frames, os.path.basename(args.osim))
     conv.write(args.out)
     if args.knee_params:

@@ -2,7 +2,7 @@
 # tracking solve on jw_fullbody at 20 nodes, at most 200 Ipopt iterations. Passes when the solve
 # ran (exit 0 or 3 = stopped short, best iterate written), every output file exists, the summary
 # has no NaN, the feasibility polish took the best iterate (violation ~1e-3 after 200 L-BFGS
-# iterations from 3.85, with the recalibrated tendon slack lengths of mjmodels/README.md) to a
+# iterations from about 4, with the recalibrated tendon slack lengths of mjmodels/README.md) to a
 # dynamically consistent point: every scaled constraint within 1e-8, defects within 1e-6.
 # About 70 s on 2 cores.
 add_test(NAME gait_track_n20

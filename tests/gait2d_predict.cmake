@@ -1,0 +1,21 @@
+# Slow end-to-end test of the predictive problem on the planar model (issue #5): mjmodels/gait2d.xml
+# (9 dof, 18 muscles) tracks the default trial's sagittal coordinates and ground reactions for
+# 100 L-BFGS iterations at 20 nodes (the guess, about 10 s), then `gaitsim predict` minimises the
+# cost of transport at 1.2 m/s with free stride time from it. Passes when predict converges by
+# the project's stopping rule (app/cmd_solve.c: Ipopt's optimal or acceptable level, i.e. feasible
+# to 1e-6 scaled and the objective settled to 1e-4 over 15 iterations): exit 0, status optimal or
+# acceptable, max violation <= 1e-6, mean speed 1.2 m/s to 1e-6, stride time within 0.8-1.6 s,
+# a positive cost of transport. Measured 2026-12-01: acceptable level after 858 iterations, 98 s
+# on 2 cores, stride 1.16 s, cost of transport 1.2 J/(kg m) (a planar model with 18 muscles).
+add_test(NAME gait2d_predict_1p2
+  COMMAND bash -c "set -e; out=$(mktemp -d); trap 'rm -rf $out' EXIT; \
+    $<TARGET_FILE:gaitsim> track ${CMAKE_SOURCE_DIR}/mjmodels/trials/jw_ngait_og5 --out $out/track \
+      --model ${CMAKE_SOURCE_DIR}/mjmodels/gait2d.xml --nodes 20 --max-iter 100 --threads 2 || [ $? -eq 3 ]; \
+    $<TARGET_FILE:gaitsim> predict --guess $out/track --model ${CMAKE_SOURCE_DIR}/mjmodels/gait2d.xml \
+      --speed 1.2 --nodes 20 --max-iter 1500 --threads 2 --out $out/predict; \
+    /usr/bin/python3 -c \"import json,sys; s=json.load(open(sys.argv[1])); \
+print(s['status'], s['iterations'], s['max_violation'], s['speed_mps'], s['stride_time_s']); \
+ok = s['status'] in ('optimal solution found', 'solved to acceptable level') and \
+s['max_violation'] <= 1e-6 and abs(s['speed_mps'] - 1.2) <= 1e-6 and 0.8 <= s['stride_time_s'] <= 1.6 and \
+s['cost_of_transport_j_per_kg_m'] > 0; sys.exit(0 if ok else 1)\" $out/predict/summary.json")
+set_tests_properties(gait2d_predict_1p2 PROPERTIES LABELS slow TIMEOUT 900)

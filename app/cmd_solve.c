@@ -514,82 +514,80 @@ done:
   return status;
 }
 
+// constraint blocks of the gait NLP, for the diagnostic lines
+enum { BLOCKS = 8 };
+static const char* kBlockNames[BLOCKS] = {"defect", "link", "eom",      "hill",
+                                          "act",    "grf",  "boundary", "fibre"};
+
+// block of constraint row r, its index within the node (state, path row, boundary row) and node
+static int block_of_row(go_gait* g, int r, int* idx, int* node) {
+  go_nlp* nlp = go_gait_nlp(g);
+  const go_gait_layout* L = go_gait_layout_get(g);
+  int p0 = go_nlp_row_path(nlp, 0, 0), b0 = go_nlp_row_boundary(nlp, 0);
+  if (r < p0) {
+    *idx = r % L->nx, *node = r / L->nx;
+    return 0;
+  }
+  if (r >= b0) {
+    *idx = r - b0, *node = 0;
+    return 6;
+  }
+  int pr = (r - p0) % L->n_path;
+  *idx = pr, *node = (r - p0) / L->n_path;
+  if (L->r_fib >= 0 && pr >= L->r_fib) return 7;
+  return pr < L->r_eom ? 1 : pr < L->r_hill ? 2 : pr < L->r_act ? 3 : pr < L->r_grf ? 4 : 5;
+}
+
+// largest of v[r] per block, one line to stderr
+static void print_block_max(go_gait* g, const double* v, int mm, const char* what, int with_node) {
+  double mx[BLOCKS] = {0};
+  int at[BLOCKS] = {0}, node[BLOCKS] = {0};
+  for (int r = 0; r < mm; r++) {
+    int idx, k, blk = block_of_row(g, r, &idx, &k);
+    if (v[r] > mx[blk]) mx[blk] = v[r], at[blk] = idx, node[blk] = k;
+  }
+  fprintf(stderr, "%s by block:", what);
+  for (int b = 0; b < (go_gait_layout_get(g)->r_fib >= 0 ? BLOCKS : BLOCKS - 1); b++) {
+    if (with_node) fprintf(stderr, " %s %.3g (#%d node %d)", kBlockNames[b], mx[b], at[b], node[b]);
+    else fprintf(stderr, " %s %.3g (#%d)", kBlockNames[b], mx[b], at[b]);
+  }
+  fprintf(stderr, "\n");
+}
+
 // largest |multiplier| per constraint block (solver scaling), one line to stderr: which
 // constraints the solve is fighting (a multiplier that grows without bound marks a degenerate or
 // nearly dependent block)
 static void print_largest_multipliers(go_gait* g, const double* lam, const char* what) {
-  go_nlp* nlp = go_gait_nlp(g);
-  const go_gait_layout* L = go_gait_layout_get(g);
-  int N = go_gait_nodes(g), n, mm, ne;
-  go_nlp_sizes(nlp, &n, &mm, &ne);
-  double mx[8] = {0};
-  int at[8] = {0}, node[8] = {0};
-  static const char* names[8] = {"defect", "link", "eom", "hill", "act", "grf", "boundary",
-                                 "fibre"};
-  int p0 = go_nlp_row_path(nlp, 0, 0), b0 = go_nlp_row_boundary(nlp, 0);
-  for (int r = 0; r < mm; r++) {
-    int blk, idx, k = 0;
-    if (r < p0) {
-      blk = 0, idx = r % L->nx, k = r / L->nx;
-    } else if (r < b0) {
-      int pr = (r - p0) % L->n_path;
-      k = (r - p0) / L->n_path;
-      blk = pr < L->r_eom ? 1 : pr < L->r_hill ? 2 : pr < L->r_act ? 3 : pr < L->r_grf ? 4 : 5;
-      if (L->r_fib >= 0 && pr >= L->r_fib) blk = 7;
-      idx = pr;
-    } else {
-      blk = 6, idx = r - b0;
-    }
-    if (fabs(lam[r]) > mx[blk]) mx[blk] = fabs(lam[r]), at[blk] = idx, node[blk] = k;
-  }
-  (void)N;
-  fprintf(stderr, "%s: largest multiplier by block:", what);
-  for (int b = 0; b < (L->r_fib >= 0 ? 8 : 7); b++)
-    fprintf(stderr, " %s %.3g (#%d node %d)", names[b], mx[b], at[b], node[b]);
-  fprintf(stderr, "\n");
+  int n, mm, ne;
+  go_nlp_sizes(go_gait_nlp(g), &n, &mm, &ne);
+  double* a = (double*)malloc(sizeof(double) * (size_t)mm);
+  if (!a) return;
+  for (int r = 0; r < mm; r++) a[r] = fabs(lam[r]);
+  char label[64];
+  snprintf(label, sizeof(label), "%s: largest multiplier", what);
+  print_block_max(g, a, mm, label, 1);
+  free(a);
 }
 
-// largest scaled violation per constraint block, one line to stderr
+// largest scaled violation per constraint block, one line to stderr: |g| for the equalities,
+// the distance outside [lb, ub] for the fibre rows
 static void print_blocks(go_gait* g, const double* gv, const char* when) {
   go_nlp* nlp = go_gait_nlp(g);
-  const go_gait_layout* L = go_gait_layout_get(g);
-  int N = go_gait_nodes(g), n, mm, ne;
+  int n, mm, ne;
   go_nlp_sizes(nlp, &n, &mm, &ne);
-  double mx[8] = {0};
-  int at[8] = {0};
-  static const char* names[8] = {"defect", "link", "eom", "hill", "act", "grf", "boundary",
-                                 "fibre"};
-  // violation of the row's bounds: |g| for the equalities, outside [lb, ub] for the fibre rows
   double* gl = (double*)malloc(sizeof(double) * (size_t)mm);
   double* gu = (double*)malloc(sizeof(double) * (size_t)mm);
   double* xl = (double*)malloc(sizeof(double) * (size_t)n);
   double* xu = (double*)malloc(sizeof(double) * (size_t)n);
-  int have_bounds = gl && gu && xl && xu;
-  if (have_bounds) go_nlp_bounds(nlp, xl, xu, gl, gu);
-  for (int r = 0; r < mm; r++) {
-    int blk;
-    int p0 = go_nlp_row_path(nlp, 0, 0), b0 = go_nlp_row_boundary(nlp, 0);
-    if (r < p0) {
-      blk = 0;
-    } else if (r < p0 + N * L->n_path) {
-      int pr = (r - p0) % L->n_path;
-      blk = pr < L->r_eom ? 1 : pr < L->r_hill ? 2 : pr < L->r_act ? 3 : pr < L->r_grf ? 4 : 5;
-      if (L->r_fib >= 0 && pr >= L->r_fib) blk = 7;
-    } else {
-      blk = 6;
-    }
-    (void)b0;
-    double v = have_bounds ? fmax(fmax(gl[r] - gv[r], gv[r] - gu[r]), 0.0) : fabs(gv[r]);
-    if (v > mx[blk]) {
-      mx[blk] = v;
-      at[blk] = blk == 0 ? r % L->nx : blk != 6 ? (r - p0) % L->n_path : r - b0;
-    }
+  double* v = (double*)malloc(sizeof(double) * (size_t)mm);
+  if (gl && gu && xl && xu && v) {
+    go_nlp_bounds(nlp, xl, xu, gl, gu);
+    for (int r = 0; r < mm; r++) v[r] = fmax(fmax(gl[r] - gv[r], gv[r] - gu[r]), 0.0);
+    char label[96];
+    snprintf(label, sizeof(label), "%s violation", when);
+    print_block_max(g, v, mm, label, 0);
   }
-  free(gl), free(gu), free(xl), free(xu);
-  fprintf(stderr, "%s violation by block:", when);
-  for (int b = 0; b < (L->r_fib >= 0 ? 8 : 7); b++)
-    fprintf(stderr, " %s %.3g (#%d)", names[b], mx[b], at[b]);
-  fprintf(stderr, "\n");
+  free(gl), free(gu), free(xl), free(xu), free(v);
 }
 
 // measured total knee contact force (N) of the trial at the N node times (caller frees), or NULL

@@ -2,15 +2,38 @@
 #include "callbacks/gs_knee.h"
 
 #include <math.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #define GS_KNEE_LIG_RAMP 0.05      // width of the ligament ramps in x = e/et   (-)
 #define GS_KNEE_MIN_LENGTH 1e-9    // guard for divisions by a length          (m)
+#define GS_KNEE_MAX_CHECK 16       // numerics whose identity a cache entry records
+#define GS_KNEE_NAME_LEN 48
+#define GS_KNEE_BLOCK 64           // elements per block of the surrogate's two passes
 
 static const char* const kKneeJoints[6] = {"knee_flexion", "knee_adduction", "knee_rotation",
                                            "knee_tx", "knee_ty", "knee_tz"};
+
+// what identifies the model a gsKneeModel was filled from (checked on every cache lookup)
+typedef struct gsKneeCheck_ {
+  const mjtNum* numeric_data;   // m->numeric_data
+  const char* names;            // m->names
+  int nnumeric, njnt, nbody;
+  int nnum;                     // numerics recorded
+  int num_id[GS_KNEE_MAX_CHECK];
+  int num_adr[GS_KNEE_MAX_CHECK];
+  int num_size[GS_KNEE_MAX_CHECK];
+  char num_name[GS_KNEE_MAX_CHECK][GS_KNEE_NAME_LEN];
+  // the numbers gsKneeModel holds copies of or derives from (info, layer, femur headers): their
+  // addresses in the model and the values they had
+  int nval;
+  const mjtNum* val_ptr[4];
+  int val_len[4];
+  mjtNum val[4][GS_KNEE_NHEAD];
+} gsKneeCheck;
 
 // write a reason into err if there is room
 static void set_err(char* err, int errlen, const char* reason) {
@@ -19,37 +42,68 @@ static void set_err(char* err, int errlen, const char* reason) {
   }
 }
 
+// remember numeric id (its name, address and size) in chk
+static void check_add(const mjModel* m, gsKneeCheck* chk, int id) {
+  if (!chk || id < 0 || chk->nnum >= GS_KNEE_MAX_CHECK) {
+    return;
+  }
+  int k = chk->nnum++;
+  chk->num_id[k] = id;
+  chk->num_adr[k] = m->numeric_adr[id];
+  chk->num_size[k] = m->numeric_size[id];
+  snprintf(chk->num_name[k], GS_KNEE_NAME_LEN, "%s", m->names + m->name_numericadr[id]);
+}
+
+// remember n (<= GS_KNEE_NHEAD) numbers at p in chk
+static void check_values(gsKneeCheck* chk, const mjtNum* p, int n) {
+  if (!chk || chk->nval >= 4 || n > GS_KNEE_NHEAD) {
+    return;
+  }
+  chk->val_ptr[chk->nval] = p;
+  chk->val_len[chk->nval] = n;
+  memcpy(chk->val[chk->nval], p, sizeof(mjtNum) * (size_t)n);
+  chk->nval++;
+}
+
 // numeric by name: data pointer and size, NULL when absent
-static const mjtNum* numeric(const mjModel* m, const char* name, int* size) {
+static const mjtNum* numeric(const mjModel* m, const char* name, int* size, gsKneeCheck* chk) {
   int id = mj_name2id(m, mjOBJ_NUMERIC, name);
   if (id < 0) {
     *size = 0;
     return NULL;
   }
+  check_add(m, chk, id);
   *size = m->numeric_size[id];
   return m->numeric_data + m->numeric_adr[id];
 }
 
 // chunked numeric NAME_0, NAME_1, ... (contiguous in numeric_data): start and total size; NULL
-// when NAME_0 is absent or a chunk is not contiguous with the previous one
-static const mjtNum* numeric_chunks(const mjModel* m, const char* name, int* size) {
+// when NAME_0 is absent or a chunk is not contiguous with the previous one. chk records the first
+// and the last chunk (together with the total size they fix the span).
+static const mjtNum* numeric_chunks(const mjModel* m, const char* name, int* size,
+                                    gsKneeCheck* chk) {
   char buf[64];
-  int total = 0;
+  int total = 0, last = -1;
   const mjtNum* start = NULL;
   for (int k = 0;; k++) {
-    int n;
     snprintf(buf, sizeof(buf), "%s_%d", name, k);
-    const mjtNum* p = numeric(m, buf, &n);
-    if (!p) {
+    int id = mj_name2id(m, mjOBJ_NUMERIC, buf);
+    if (id < 0) {
       break;
     }
+    const mjtNum* p = m->numeric_data + m->numeric_adr[id];
     if (k == 0) {
       start = p;
+      check_add(m, chk, id);
     } else if (p != start + total) {
       *size = 0;
       return NULL;
     }
-    total += n;
+    total += m->numeric_size[id];
+    last = id;
+  }
+  if (last >= 0 && chk && (chk->nnum == 0 || chk->num_id[chk->nnum - 1] != last)) {
+    check_add(m, chk, last);
   }
   *size = total;
   return start;
@@ -76,43 +130,120 @@ mjtNum gs_knee_ramp(mjtNum x, mjtNum eps) {
   return 0.5 * (x + sqrt(x * x + eps * eps));
 }
 
-int gs_knee_model_init(const mjModel* m, gsKneeModel* km, char* err, int errlen) {
-  int n_info, n_layer, n_torus, n_elem, n_lig;
-  const mjtNum* info = numeric(m, "gs_knee_info", &n_info);
+// gs_knee_model_init, recording in chk (may be NULL) what identifies m
+static int model_init(const mjModel* m, gsKneeModel* km, gsKneeCheck* chk, char* err,
+                      int errlen) {
+  int n_info, n_layer, n_femur, n_elem, n_lig;
   memset(km, 0, sizeof(*km));
+  if (chk) {
+    memset(chk, 0, sizeof(*chk));
+    chk->numeric_data = m->numeric_data;
+    chk->names = m->names;
+    chk->nnumeric = m->nnumeric;
+    chk->njnt = m->njnt;
+    chk->nbody = m->nbody;
+  }
+  const mjtNum* info = numeric(m, "gs_knee_info", &n_info, chk);
   if (!info) {
     return 0;
   }
 
   // sizes and version
-  const mjtNum* layer = numeric(m, "gs_knee_layer", &n_layer);
-  const mjtNum* torus = numeric(m, "gs_knee_torus", &n_torus);
-  const mjtNum* elem = numeric_chunks(m, "gs_knee_elements", &n_elem);
-  const mjtNum* lig = numeric_chunks(m, "gs_knee_ligaments", &n_lig);
-  if (n_info != 4 || info[0] != 1.0) {
-    set_err(err, errlen, "gs_knee_info must be (1, n_medial, n_lateral, n_ligaments)");
+  const mjtNum* layer = numeric(m, "gs_knee_layer", &n_layer, chk);
+  const mjtNum* femur = numeric_chunks(m, "gs_knee_femur", &n_femur, chk);
+  const mjtNum* elem = numeric_chunks(m, "gs_knee_elements", &n_elem, chk);
+  const mjtNum* lig = numeric_chunks(m, "gs_knee_ligaments", &n_lig, chk);
+  if (n_info != 9 || info[0] != 2.0) {
+    set_err(err, errlen, "gs_knee_info must be version 2 with 9 numbers (regenerate the model "
+                         "with scripts/prepare_knee.py)");
     return -1;
+  }
+  for (int i = 1; i < 9; i++) {
+    if (!(info[i] >= 0.0 && info[i] <= 1e6) || info[i] != floor(info[i])) {
+      set_err(err, errlen, "gs_knee_info: counts must be non-negative integers");
+      return -1;
+    }
   }
   km->nelem[0] = (int)info[1];
   km->nelem[1] = (int)info[2];
   km->nlig = (int)info[3];
-  if (!layer || n_layer != 2 || !torus || n_torus != 2 * GS_KNEE_NTORUS || !elem ||
-      km->nelem[0] < 0 || km->nelem[1] < 0 || km->nlig < 0 ||
+  km->ncw = (int)info[4];
+  km->ncz = (int)info[5];
+  km->deg = (int)info[6];
+  km->ntw = (int)info[7];
+  km->ntz = (int)info[8];
+  km->nterm = (km->deg + 1) * (km->deg + 2) / 2;
+  int ncoef = km->ncw * km->ncz * km->nterm;
+  int nblock = GS_KNEE_NHEAD + 2 * ncoef + km->ntw * km->ntz;
+  if (km->ncw < 1 || km->ncz < 1 || km->deg > 12 || km->ntw < 1 || km->ntz < 1 || !layer ||
+      n_layer != 9 || !femur || n_femur != 2 * nblock || !elem ||
       n_elem != GS_KNEE_NELEM * (km->nelem[0] + km->nelem[1]) ||
       (km->nlig > 0 && (!lig || n_lig != GS_KNEE_NLIG * km->nlig))) {
     set_err(err, errlen, "gs_knee numerics missing or of the wrong size");
     return -1;
   }
-  if (!(layer[0] > 0.0) || !(layer[1] > 0.0)) {
-    set_err(err, errlen, "gs_knee_layer: K/h and eps must be > 0");
-    return -1;
+  for (int i = 0; i < 9; i++) {
+    if (!(layer[i] > 0.0)) {
+      set_err(err, errlen, "gs_knee_layer: every value must be > 0");
+      return -1;
+    }
   }
+  check_values(chk, info, 9);
+  check_values(chk, layer, 9);
   km->k_over_h = layer[0];
   km->ramp_eps = layer[1];
-  km->torus[0] = torus;
-  km->torus[1] = torus + GS_KNEE_NTORUS;
+  km->ramp_cut = layer[2];
+  km->edge_width = layer[3];
+  km->tau_w = layer[4];
+  km->tau_z = layer[5];
+  km->tau_c = layer[6];
+  km->c0 = layer[7];
+  km->tau_f = layer[8];
+  km->itau_w = 1.0 / km->tau_w;
+  km->itau_z = 1.0 / km->tau_z;
+  km->itau_c = 1.0 / km->tau_c;
+  km->itau_f = 1.0 / km->tau_f;
+  km->iedge = 1.0 / km->edge_width;
+  km->icut = 1.0 / km->ramp_cut;
   km->elem[0] = elem;
   km->elem[1] = elem + GS_KNEE_NELEM * km->nelem[0];
+  for (int c = 0; c < 2; c++) {
+    const mjtNum* h = femur + c * nblock;
+    gsKneeFemur* fm = km->fem + c;
+    check_values(chk, h, GS_KNEE_NHEAD);
+    // domain and cells: W0 < W1, Z0 < Z1, positive spacing, blends within half a cell
+    if (!(h[5] > h[4]) || !(h[7] > h[6]) || !(h[8] > 0.0) || !(h[9] > 0.0) ||
+        !(h[10] > 0.0) || !(h[11] > 0.0) || !(2.0 * h[10] < h[8]) || !(2.0 * h[11] < h[9])) {
+      set_err(err, errlen, "gs_knee_femur: bad domain, cells or blends");
+      return -1;
+    }
+    fm->gcoef = h + GS_KNEE_NHEAD;
+    fm->ecoef = fm->gcoef + ncoef;
+    fm->table = fm->ecoef + ncoef;
+    fm->ax = h[0];
+    fm->ay = h[1];
+    fm->cm = h[2];
+    fm->sm = h[3];
+    fm->w0 = h[4];
+    fm->w1 = h[5];
+    fm->z0 = h[6];
+    fm->z1 = h[7];
+    fm->hw = h[8];
+    fm->hz = h[9];
+    fm->dw = h[10];
+    fm->dz = h[11];
+    fm->ihw = 1.0 / h[8];
+    fm->ihz = 1.0 / h[9];
+    if (!(h[14] > h[13])) {
+      set_err(err, errlen, "gs_knee_femur: bad cull-table range");
+      return -1;
+    }
+    fm->s0 = h[13];
+    fm->s1 = h[14];
+    fm->ts = km->ntw / (h[14] - h[13]);
+    fm->tz = km->ntz / (h[7] - h[6]);
+    fm->scale = h[12] * km->k_over_h;
+  }
   km->lig = km->nlig > 0 ? lig : NULL;
 
   // joints and bodies by name
@@ -122,6 +253,14 @@ int gs_knee_model_init(const mjModel* m, gsKneeModel* km, char* err, int errlen)
       set_err(err, errlen, "a knee joint (knee_flexion ... knee_tz) is missing");
       return -1;
     }
+    int t = m->jnt_type[km->jnt[i]];
+    if (t != mjJNT_HINGE && t != mjJNT_SLIDE) {
+      set_err(err, errlen, "the six knee joints must be hinges or slides");
+      return -1;
+    }
+    km->qadr[i] = m->jnt_qposadr[km->jnt[i]];
+    km->dadr[i] = m->jnt_dofadr[km->jnt[i]];
+    km->hinge[i] = t == mjJNT_HINGE;
   }
   km->body_fem = mj_name2id(m, mjOBJ_BODY, "femoral_component");
   km->body_tib = mj_name2id(m, mjOBJ_BODY, "tibial_tray");
@@ -138,38 +277,330 @@ int gs_knee_model_init(const mjModel* m, gsKneeModel* km, char* err, int errlen)
   return 1;
 }
 
+int gs_knee_model_init(const mjModel* m, gsKneeModel* km, char* err, int errlen) {
+  return model_init(m, km, NULL, err, errlen);
+}
+
+// ---- per-model cache ----------------------------------------------------------------------
+//
+// Entries are immutable once published. A slot is replaced under the lock by storing a new
+// entry pointer; the replaced entry stays allocated (kept on a list so it remains reachable) for
+// the life of the process, because a concurrent lookup may still be reading it. Registrations
+// are rare (once per prepared model), so the list stays short.
+typedef struct gsKneeEntry_ {
+  const mjModel* m;
+  gsKneeCheck chk;
+  gsKneeModel km;
+  struct gsKneeEntry_* retired;  // next on the list of replaced entries
+} gsKneeEntry;
+
+static _Atomic(gsKneeEntry*) g_slots[GS_KNEE_CACHE_SLOTS];
+static pthread_mutex_t g_slots_lock = PTHREAD_MUTEX_INITIALIZER;
+static int g_slots_next;              // round-robin victim when all slots hold other models
+static gsKneeEntry* g_retired;         // replaced entries (under the lock)
+
+// does entry e still describe m? O(1): pointers, counts, and the recorded names/sizes
+static int entry_matches(const mjModel* m, const gsKneeEntry* e) {
+  const gsKneeCheck* c = &e->chk;
+  const gsKneeModel* km = &e->km;
+  if (e->m != m || c->numeric_data != m->numeric_data || c->names != m->names ||
+      c->nnumeric != m->nnumeric || c->njnt != m->njnt || c->nbody != m->nbody) {
+    return 0;
+  }
+  for (int k = 0; k < c->nnum; k++) {
+    int id = c->num_id[k];
+    if (m->numeric_adr[id] != c->num_adr[k] || m->numeric_size[id] != c->num_size[k] ||
+        strcmp(m->names + m->name_numericadr[id], c->num_name[k]) != 0) {
+      return 0;
+    }
+  }
+  // same numbers where the copies came from (same addresses: numeric_data and adr checked)
+  for (int k = 0; k < c->nval; k++) {
+    if (memcmp(c->val_ptr[k], c->val[k], sizeof(mjtNum) * (size_t)c->val_len[k]) != 0) {
+      return 0;
+    }
+  }
+  for (int i = 0; i < 6; i++) {
+    int j = km->jnt[i];
+    if (m->jnt_bodyid[j] != km->body_tib || m->jnt_qposadr[j] != km->qadr[i] ||
+        m->jnt_dofadr[j] != km->dadr[i] || (m->jnt_type[j] == mjJNT_HINGE) != km->hinge[i] ||
+        strcmp(m->names + m->name_jntadr[j], kKneeJoints[i]) != 0) {
+      return 0;
+    }
+  }
+  return strcmp(m->names + m->name_bodyadr[km->body_fem], "femoral_component") == 0 &&
+         strcmp(m->names + m->name_bodyadr[km->body_tib], "tibial_tray") == 0;
+}
+
+static int g_lazy_count;               // registrations made by gs_knee_passive (under the lock)
+
+// register m; lazy: made by gs_knee_passive on a miss (counted, at most GS_KNEE_CACHE_LAZY_MAX,
+// and skipped when another thread registered m meanwhile)
+static int register_model(const mjModel* m, int lazy, char* err, int errlen) {
+  if (lazy) {
+    pthread_mutex_lock(&g_slots_lock);
+    int full = g_lazy_count >= GS_KNEE_CACHE_LAZY_MAX;
+    pthread_mutex_unlock(&g_slots_lock);
+    if (full) {
+      return 0;
+    }
+  }
+  gsKneeEntry* e = calloc(1, sizeof(*e));
+  if (!e) {
+    set_err(err, errlen, "out of memory");
+    return -1;
+  }
+  int rc = model_init(m, &e->km, &e->chk, err, errlen);
+  if (rc != 1) {
+    free(e);
+    return rc;
+  }
+  e->m = m;
+  pthread_mutex_lock(&g_slots_lock);
+  int slot = -1;
+  for (int i = 0; i < GS_KNEE_CACHE_SLOTS && slot < 0; i++) {
+    gsKneeEntry* old = atomic_load_explicit(&g_slots[i], memory_order_acquire);
+    if (old && old->m == m) {
+      slot = i;  // the same address again: this model or a new one there
+    }
+  }
+  if (lazy && (g_lazy_count >= GS_KNEE_CACHE_LAZY_MAX ||
+               (slot >= 0 && entry_matches(m, atomic_load_explicit(&g_slots[slot],
+                                                                     memory_order_acquire))))) {
+    pthread_mutex_unlock(&g_slots_lock);
+    free(e);  // full, or another thread was first
+    return 1;
+  }
+  for (int i = 0; i < GS_KNEE_CACHE_SLOTS && slot < 0; i++) {
+    if (!atomic_load_explicit(&g_slots[i], memory_order_acquire)) {
+      slot = i;
+    }
+  }
+  if (slot < 0) {
+    slot = g_slots_next;
+    g_slots_next = (g_slots_next + 1) % GS_KNEE_CACHE_SLOTS;
+  }
+  gsKneeEntry* old = atomic_exchange_explicit(&g_slots[slot], e, memory_order_acq_rel);
+  if (old) {
+    old->retired = g_retired;
+    g_retired = old;
+  }
+  g_lazy_count += lazy;
+  pthread_mutex_unlock(&g_slots_lock);
+  return 1;
+}
+
+int gs_knee_register(const mjModel* m, char* err, int errlen) {
+  return register_model(m, 0, err, errlen);
+}
+
+const gsKneeModel* gs_knee_lookup(const mjModel* m) {
+  for (int i = 0; i < GS_KNEE_CACHE_SLOTS; i++) {
+    const gsKneeEntry* e = atomic_load_explicit(&g_slots[i], memory_order_acquire);
+    if (e && e->m == m) {
+      return entry_matches(m, e) ? &e->km : NULL;
+    }
+  }
+  return NULL;
+}
+
+// C-infinity step: 0 for t <= 0, 1 for t >= 1, 1 / (1 + exp((1 - 2t) / (t (1 - t)))) between
+// (exp overflows to +inf near t = 0, which gives exactly 0)
+static mjtNum smooth_step(mjtNum t) {
+  if (t <= 0.0) {
+    return 0.0;
+  }
+  if (t >= 1.0) {
+    return 1.0;
+  }
+  return 1.0 / (1.0 + exp((1.0 - 2.0 * t) / (t * (1.0 - t))));
+}
+
+// partition of unity along one axis, for x inside [x0, x0 + nc h]: the one or two cells of x
+// and their weights
+static int pu_axis(mjtNum x, mjtNum x0, mjtNum h, mjtNum ih, mjtNum d, int nc, int idx[2],
+                   mjtNum wt[2]) {
+  int i = (int)((x - x0) * ih);
+  i = i < 0 ? 0 : (i > nc - 1 ? nc - 1 : i);
+  mjtNum s = x - (x0 + i * h);
+  if (i > 0 && s < d) {
+    mjtNum up = smooth_step((s + d) / (2.0 * d));
+    idx[0] = i - 1;
+    idx[1] = i;
+    wt[0] = 1.0 - up;
+    wt[1] = up;
+    return 2;
+  }
+  if (i < nc - 1 && s > h - d) {
+    mjtNum up = smooth_step((s - h + d) / (2.0 * d));
+    idx[0] = i;
+    idx[1] = i + 1;
+    wt[0] = 1.0 - up;
+    wt[1] = up;
+    return 2;
+  }
+  idx[0] = i;
+  wt[0] = 1.0;
+  return 1;
+}
+
+// sum over a = 0..deg, b = 0..deg-a of c_ab u^a v^b (a outer), by Horner in v then u
+static mjtNum poly2(const mjtNum* c, int deg, mjtNum u, mjtNum v) {
+  if (deg == 4) {
+    mjtNum r0 = c[0] + v * (c[1] + v * (c[2] + v * (c[3] + v * c[4])));
+    mjtNum r1 = c[5] + v * (c[6] + v * (c[7] + v * c[8]));
+    mjtNum r2 = c[9] + v * (c[10] + v * c[11]);
+    mjtNum r3 = c[12] + v * c[13];
+    return r0 + u * (r1 + u * (r2 + u * (r3 + u * c[14])));
+  }
+  int off = (deg + 1) * (deg + 2) / 2;
+  mjtNum res = 0.0;
+  for (int a = deg; a >= 0; a--) {
+    int n = deg + 1 - a;
+    off -= n;
+    mjtNum inner = 0.0;
+    for (int b = n - 1; b >= 0; b--) {
+      inner = inner * v + c[off + b];
+    }
+    res = res * u + inner;
+  }
+  return res;
+}
+
+// a partition-of-unity field (coefficients coef) of condyle fm at (w, z) inside the domain
+static mjtNum pu_field(const gsKneeModel* km, const gsKneeFemur* fm, const mjtNum* coef,
+                       mjtNum w, mjtNum z) {
+  int iw[2], iz[2];
+  mjtNum aw[2], az[2];
+  int nw = pu_axis(w, fm->w0, fm->hw, fm->ihw, fm->dw, km->ncw, iw, aw);
+  int nz = pu_axis(z, fm->z0, fm->hz, fm->ihz, fm->dz, km->ncz, iz, az);
+  if (nw == 1 && nz == 1) {
+    // inside one cell (most points): its polynomial alone
+    mjtNum u = (w - (fm->w0 + (iw[0] + 0.5) * fm->hw)) * (2.0 * fm->ihw);
+    mjtNum v = (z - (fm->z0 + (iz[0] + 0.5) * fm->hz)) * (2.0 * fm->ihz);
+    return poly2(coef + (iw[0] * km->ncz + iz[0]) * km->nterm, km->deg, u, v);
+  }
+  mjtNum res = 0.0;
+  for (int a = 0; a < nw; a++) {
+    mjtNum u = (w - (fm->w0 + (iw[a] + 0.5) * fm->hw)) * (2.0 * fm->ihw);
+    for (int b = 0; b < nz; b++) {
+      mjtNum v = (z - (fm->z0 + (iz[b] + 0.5) * fm->hz)) * (2.0 * fm->ihz);
+      const mjtNum* c = coef + (iw[a] * km->ncz + iz[b]) * km->nterm;
+      res += aw[a] * az[b] * poly2(c, km->deg, u, v);
+    }
+  }
+  return res;
+}
+
 void gs_knee_surrogate(const gsKneeModel* km, const mjtNum q[6], gsKneeContact* out) {
   mjtNum R[9], t[3];
-  mjtNum th = q[GS_KNEE_FLEX];
-  mjtNum eps2 = km->ramp_eps * km->ramp_eps;
+  mjtNum eps2 = km->ramp_eps * km->ramp_eps, cut = km->ramp_cut;
   gs_knee_pose(q, R, t);
   memset(out, 0, sizeof(*out));
 
-  for (int c = 0; c < 2; c++) {
-    // torus of this compartment at this flexion
-    const mjtNum* p = km->torus[c];
-    mjtNum cx = p[0] + th * (p[1] + th * p[2]);
-    mjtNum cy = p[3] + th * (p[4] + th * p[5]);
-    mjtNum cz = p[6] + th * p[7], rmaj = p[8] + th * p[9], rmin = p[10];
-    mjtNum scale = 0.5 * p[11] * km->k_over_h;
-    mjtNum f[3] = {0, 0, 0}, mo[3] = {0, 0, 0};
-    const mjtNum* e = km->elem[c];
+  // element centre c in the femoral frame: R^T (c - t) = R^T c - R^T t
+  mjtNum rt[3] = {R[0] * t[0] + R[3] * t[1] + R[6] * t[2], R[1] * t[0] + R[4] * t[1] + R[7] * t[2],
+                  R[2] * t[0] + R[5] * t[1] + R[8] * t[2]};
 
-    // one pass over the tibial elements
-    for (int j = 0; j < km->nelem[c]; j++, e += GS_KNEE_NELEM) {
-      mjtNum d0 = e[0] - t[0], d1 = e[1] - t[1], d2 = e[2] - t[2];
-      mjtNum px = R[0] * d0 + R[3] * d1 + R[6] * d2 - cx;
-      mjtNum py = R[1] * d0 + R[4] * d1 + R[7] * d2 - cy;
-      mjtNum pz = R[2] * d0 + R[5] * d1 + R[8] * d2 - cz;
-      mjtNum u = sqrt(px * px + py * py) - rmaj;
-      mjtNum pen = rmin - sqrt(u * u + pz * pz);
-      mjtNum w = scale * (pen + sqrt(pen * pen + eps2)) * e[6];
-      f[0] -= w * e[3];
-      f[1] -= w * e[4];
-      f[2] -= w * e[5];
-      mo[0] -= w * (e[1] * e[5] - e[2] * e[4]);
-      mo[1] -= w * (e[2] * e[3] - e[0] * e[5]);
-      mo[2] -= w * (e[0] * e[4] - e[1] * e[3]);
+  for (int c = 0; c < 2; c++) {
+    const gsKneeFemur* fm = km->fem + c;
+    mjtNum f[3] = {0, 0, 0}, mo[3] = {0, 0, 0};
+    // A = rho sin(phi - phi_mid) = vx cm + vy sm, C = rho cos(phi - phi_mid) = vx sm - vy cm with
+    // (vx, vy) = (R^T c)_xy - R^T t - (ax, ay): A = a . c - a0, C = b . c - b0 (rows of R^T
+    // combined), z = (R^T c)_z - (R^T t)_z; rho^2 = A^2 + C^2
+    mjtNum av[3], bv[3];
+    for (int i = 0; i < 3; i++) {
+      av[i] = R[3 * i] * fm->cm + R[3 * i + 1] * fm->sm;
+      bv[i] = R[3 * i] * fm->sm - R[3 * i + 1] * fm->cm;
+    }
+    mjtNum ox = rt[0] + fm->ax, oy = rt[1] + fm->ay, oz = rt[2];
+    mjtNum a0 = ox * fm->cm + oy * fm->sm, b0 = ox * fm->sm - oy * fm->cm;
+    int n = km->nelem[c];
+    const mjtNum* ex = km->elem[c];
+    const mjtNum *ey = ex + n, *ez = ex + 2 * n, *enx = ex + 3 * n, *eny = ex + 4 * n;
+    const mjtNum *enz = ex + 5 * n, *ea = ex + 6 * n;
+    mjtNum a_0 = av[0], a_1 = av[1], a_2 = av[2], b_0 = bv[0], b_1 = bv[1], b_2 = bv[2];
+    mjtNum r_2 = R[2], r_5 = R[5], r_8 = R[8];
+    mjtNum z0 = fm->z0, z1 = fm->z1, s0 = fm->s0, s1 = fm->s1;
+
+    for (int j0 = 0; j0 < n; j0 += GS_KNEE_BLOCK) {
+      int nb = n - j0 < GS_KNEE_BLOCK ? n - j0 : GS_KNEE_BLOCK;
+      mjtNum bA[GS_KNEE_BLOCK], bC[GS_KNEE_BLOCK], bz[GS_KNEE_BLOCK], bs[GS_KNEE_BLOCK];
+      mjtNum bok[GS_KNEE_BLOCK];
+
+      // pass 1, branch-free (the compiler vectorizes it): position about the condyle's axis,
+      // s = A / C, and whether the element lies in the domain
+      for (int k = 0; k < nb; k++) {
+        int j = j0 + k;
+        mjtNum z = r_2 * ex[j] + r_5 * ey[j] + r_8 * ez[j] - oz;
+        mjtNum C = b_0 * ex[j] + b_1 * ey[j] + b_2 * ez[j] - b0;
+        mjtNum A = a_0 * ex[j] + a_1 * ey[j] + a_2 * ez[j] - a0;
+        mjtNum sv = A / C;
+        bA[k] = A;
+        bC[k] = C;
+        bz[k] = z;
+        bs[k] = sv;
+        bok[k] = (z > z0 && z < z1 && C > 0.0 && sv > s0 && sv < s1) ? 1.0 : 0.0;
+      }
+
+      // pass 2: the elements in the domain
+      for (int k = 0; k < nb; k++) {
+        if (bok[k] == 0.0) {
+          continue;
+        }
+        int j = j0 + k;
+        mjtNum A = bA[k], C = bC[k], z = bz[k], sv = bs[k];
+
+        // cull table: rho^2 beyond (bound of G over this bin + 2 b)^2 means no load (exact);
+        // a negative entry: the masks are exactly 1 throughout the bin
+        mjtNum r2 = A * A + C * C;
+        int ti = (int)((sv - fm->s0) * fm->ts), tj = (int)((z - fm->z0) * fm->tz);
+        ti = ti > km->ntw - 1 ? km->ntw - 1 : ti;
+        tj = tj > km->ntz - 1 ? km->ntz - 1 : tj;
+        mjtNum bin = fm->table[ti * km->ntz + tj];
+        if (r2 > fabs(bin)) {
+          continue;
+        }
+        mjtNum rho = sqrt(r2);
+        mjtNum inv = 1.0 / rho;
+        mjtNum w = A * inv, cc = C * inv;
+        if (!(w > fm->w0 && w < fm->w1 && cc > km->c0)) {
+          continue;  // domain mask exactly 0
+        }
+
+        // radial overlap; nothing below -2 b
+        mjtNum g = pu_field(km, fm, fm->gcoef, w, z) - rho;
+        if (g <= -2.0 * cut) {
+          continue;
+        }
+        mjtNum mask = 1.0;
+        if (!(bin < 0.0)) {
+          mask = smooth_step((w - fm->w0) * km->itau_w) * smooth_step((fm->w1 - w) * km->itau_w) *
+                 smooth_step((cc - km->c0) * km->itau_c) * smooth_step((z - fm->z0) * km->itau_z) *
+                 smooth_step((fm->z1 - z) * km->itau_z);
+          mask *= smooth_step(pu_field(km, fm, fm->ecoef, w, z) * km->iedge + 0.5);
+          if (mask == 0.0) {
+            continue;
+          }
+        }
+
+        // pressure x area along the element normal
+        mjtNum r = 0.5 * (g + sqrt(g * g + eps2)) * smooth_step((g + 2.0 * cut) * km->icut);
+        // cosine of the element normal to the radial direction: -(v . n')_xy / rho, in the rotated
+        // basis -(A n_a + C n_b) / rho
+        mjtNum n0 = enx[j], n1 = eny[j], n2 = enz[j];
+        mjtNum na = a_0 * n0 + a_1 * n1 + a_2 * n2;
+        mjtNum nbv = b_0 * n0 + b_1 * n1 + b_2 * n2;
+        mjtNum cosn = -(A * na + C * nbv) * inv;
+        cosn *= smooth_step(cosn * km->itau_f);
+        mjtNum wgt = fm->scale * r * cosn * mask * ea[j];
+        f[0] -= wgt * n0;
+        f[1] -= wgt * n1;
+        f[2] -= wgt * n2;
+        mo[0] -= wgt * (ey[j] * n2 - ez[j] * n1);
+        mo[1] -= wgt * (ez[j] * n0 - ex[j] * n2);
+        mo[2] -= wgt * (ex[j] * n1 - ey[j] * n0);
+      }
     }
     for (int i = 0; i < 3; i++) {
       out->force[c][i] = f[i];
@@ -208,52 +639,23 @@ mjtNum gs_knee_ligament_force(const mjtNum row[GS_KNEE_NLIG], mjtNum length, mjt
   return spring + c * (speed / l0) * step;
 }
 
-// add the generalized forces of a force F (world) at world point p on the tibia to the six knee
-// dofs: hinge a.((p - anchor) x F), slide a.F (MuJoCo joint axes and anchors of the tibia body)
-static void add_point_force(const gsKneeModel* km, const mjModel* m, const mjData* d,
-                            const mjtNum p[3], const mjtNum F[3], mjtNum Q[6]) {
-  for (int i = 0; i < 6; i++) {
-    int j = km->jnt[i];
-    const mjtNum* a = d->xaxis + 3 * j;
-    if (m->jnt_type[j] == mjJNT_HINGE) {
-      const mjtNum* o = d->xanchor + 3 * j;
-      mjtNum r[3] = {p[0] - o[0], p[1] - o[1], p[2] - o[2]};
-      mjtNum mx = r[1] * F[2] - r[2] * F[1];
-      mjtNum my = r[2] * F[0] - r[0] * F[2];
-      mjtNum mz = r[0] * F[1] - r[1] * F[0];
-      Q[i] += a[0] * mx + a[1] * my + a[2] * mz;
-    } else {
-      Q[i] += a[0] * F[0] + a[1] * F[1] + a[2] * F[2];
-    }
-  }
-}
-
-// add a pure moment (world) on the tibia: hinge a.M, slide 0
-static void add_moment(const gsKneeModel* km, const mjModel* m, const mjData* d,
-                       const mjtNum M[3], mjtNum Q[6]) {
-  for (int i = 0; i < 6; i++) {
-    int j = km->jnt[i];
-    if (m->jnt_type[j] == mjJNT_HINGE) {
-      const mjtNum* a = d->xaxis + 3 * j;
-      Q[i] += a[0] * M[0] + a[1] * M[1] + a[2] * M[2];
-    }
-  }
-}
-
-// velocity (world) of world point p fixed to body b: v = v_origin + w x (p - xpos)
-static void point_velocity(const mjModel* m, const mjData* d, int b, const mjtNum p[3],
-                           mjtNum v[3]) {
-  mjtNum vel[6];
-  mj_objectVelocity(m, d, mjOBJ_BODY, b, vel, 0);
-  const mjtNum* x = d->xpos + 3 * b;
-  mjtNum r[3] = {p[0] - x[0], p[1] - x[1], p[2] - x[2]};
-  v[0] = vel[3] + vel[1] * r[2] - vel[2] * r[1];
-  v[1] = vel[4] + vel[2] * r[0] - vel[0] * r[2];
-  v[2] = vel[5] + vel[0] * r[1] - vel[1] * r[0];
+// velocity (world) of body b's motion: angular w and linear v0 of the point at the origin of the
+// world frame moving with b, from MuJoCo's com-based cvel (rotation; translation of the point at
+// the subtree centre of mass of b's root), so v(p) = v0 + w x p
+static void body_twist(const mjModel* m, const mjData* d, int b, mjtNum w[3], mjtNum v0[3]) {
+  const mjtNum* cv = d->cvel + 6 * b;
+  const mjtNum* c = d->subtree_com + 3 * m->body_rootid[b];
+  w[0] = cv[0];
+  w[1] = cv[1];
+  w[2] = cv[2];
+  // v0 = v_c + w x (0 - c)
+  v0[0] = cv[3] - (w[1] * c[2] - w[2] * c[1]);
+  v0[1] = cv[4] - (w[2] * c[0] - w[0] * c[2]);
+  v0[2] = cv[5] - (w[0] * c[1] - w[1] * c[0]);
 }
 
 void gs_knee_passive_model(const gsKneeModel* km, const mjModel* m, mjData* d, gsKneeLoads* out) {
-  mjtNum q[6], Q[6] = {0, 0, 0, 0, 0, 0};
+  mjtNum q[6];
   gsKneeLoads loads;
   const mjtNum* xt = d->xpos + 3 * km->body_tib;
   const mjtNum* Rt = d->xmat + 9 * km->body_tib;
@@ -261,25 +663,38 @@ void gs_knee_passive_model(const gsKneeModel* km, const mjModel* m, mjData* d, g
   const mjtNum* Rf = d->xmat + 9 * km->body_fem;
   memset(&loads, 0, sizeof(loads));
 
-  // coordinates by name
+  // coordinates (addresses cached in km)
   for (int i = 0; i < 6; i++) {
-    q[i] = d->qpos[m->jnt_qposadr[km->jnt[i]]];
+    q[i] = d->qpos[km->qadr[i]];
   }
 
-  // contact: per compartment the force at the tibial_tray origin plus its moment, in world
+  // everything acting on the tibia is summed into a force F and a moment M about the tibial
+  // origin xt (world frame), projected on the six joints once at the end
+  mjtNum F[3] = {0, 0, 0}, M[3] = {0, 0, 0};
+
+  // contact: per compartment a force at the tibial_tray origin plus its moment (tibial frame)
   gs_knee_surrogate(km, q, &loads.contact);
-  for (int c = 0; c < 2; c++) {
-    mjtNum F[3], M[3];
-    mju_mulMatVec(F, Rt, loads.contact.force[c], 3, 3);
-    mju_mulMatVec(M, Rt, loads.contact.moment[c], 3, 3);
-    add_point_force(km, m, d, xt, F, Q);
-    add_moment(km, m, d, M, Q);
+  {
+    mjtNum fl[3], ml[3];
+    for (int i = 0; i < 3; i++) {
+      fl[i] = loads.contact.force[0][i] + loads.contact.force[1][i];
+      ml[i] = loads.contact.moment[0][i] + loads.contact.moment[1][i];
+    }
+    mjtNum fw[3], mw[3];
+    mju_mulMatVec(fw, Rt, fl, 3, 3);
+    mju_mulMatVec(mw, Rt, ml, 3, 3);
+    mju_addTo3(F, fw);
+    mju_addTo3(M, mw);
   }
 
-  // ligaments: tension along the line tibial point -> femoral point, on the tibia
+  // ligaments: tension along the line tibial point -> femoral point, on the tibia; lengthening
+  // speed from the two bodies' twists (one look-up each, not one per bundle)
+  mjtNum wf[3], vf0[3], wt[3], vt0[3];
+  body_twist(m, d, km->body_fem, wf, vf0);
+  body_twist(m, d, km->body_tib, wt, vt0);
   for (int b = 0; b < km->nlig; b++) {
     const mjtNum* row = km->lig + GS_KNEE_NLIG * b;
-    mjtNum pf[3], pt[3], u[3], vf[3], vt[3];
+    mjtNum pf[3], pt[3], u[3];
     mju_mulMatVec(pf, Rf, row, 3, 3);
     mju_mulMatVec(pt, Rt, row + 3, 3, 3);
     for (int i = 0; i < 3; i++) {
@@ -292,19 +707,43 @@ void gs_knee_passive_model(const gsKneeModel* km, const mjModel* m, mjData* d, g
       continue;
     }
     mju_scl3(u, u, 1.0 / len);
-    point_velocity(m, d, km->body_fem, pf, vf);
-    point_velocity(m, d, km->body_tib, pt, vt);
-    mjtNum speed = u[0] * (vf[0] - vt[0]) + u[1] * (vf[1] - vt[1]) + u[2] * (vf[2] - vt[2]);
+    // relative velocity of the femoral point against the tibial point
+    mjtNum dv[3];
+    for (int i = 0; i < 3; i++) {
+      int i1 = (i + 1) % 3, i2 = (i + 2) % 3;
+      dv[i] = vf0[i] - vt0[i] + (wf[i1] * pf[i2] - wf[i2] * pf[i1]) -
+              (wt[i1] * pt[i2] - wt[i2] * pt[i1]);
+    }
+    mjtNum speed = u[0] * dv[0] + u[1] * dv[1] + u[2] * dv[2];
     mjtNum ten = gs_knee_ligament_force(row, len, speed);
-    mjtNum F[3] = {ten * u[0], ten * u[1], ten * u[2]};
-    add_point_force(km, m, d, pt, F, Q);
+    mjtNum f[3] = {ten * u[0], ten * u[1], ten * u[2]};
+    mjtNum r[3] = {pt[0] - xt[0], pt[1] - xt[1], pt[2] - xt[2]};
+    F[0] += f[0];
+    F[1] += f[1];
+    F[2] += f[2];
+    M[0] += r[1] * f[2] - r[2] * f[1];
+    M[1] += r[2] * f[0] - r[0] * f[2];
+    M[2] += r[0] * f[1] - r[1] * f[0];
     loads.ligament_force += ten;
   }
 
-  // accumulate
+  // generalized forces: hinge a.(M + (xt - anchor) x F), slide a.F (joints of the tibia body)
   for (int i = 0; i < 6; i++) {
-    d->qfrc_passive[m->jnt_dofadr[km->jnt[i]]] += Q[i];
-    loads.qfrc[i] = Q[i];
+    int j = km->jnt[i];
+    const mjtNum* a = d->xaxis + 3 * j;
+    mjtNum Qi;
+    if (km->hinge[i]) {
+      const mjtNum* o = d->xanchor + 3 * j;
+      mjtNum r[3] = {xt[0] - o[0], xt[1] - o[1], xt[2] - o[2]};
+      mjtNum mx = M[0] + r[1] * F[2] - r[2] * F[1];
+      mjtNum my = M[1] + r[2] * F[0] - r[0] * F[2];
+      mjtNum mz = M[2] + r[0] * F[1] - r[1] * F[0];
+      Qi = a[0] * mx + a[1] * my + a[2] * mz;
+    } else {
+      Qi = a[0] * F[0] + a[1] * F[1] + a[2] * F[2];
+    }
+    d->qfrc_passive[km->dadr[i]] += Qi;
+    loads.qfrc[i] = Qi;
   }
   if (out) {
     *out = loads;
@@ -312,6 +751,14 @@ void gs_knee_passive_model(const gsKneeModel* km, const mjModel* m, mjData* d, g
 }
 
 int gs_knee_passive(const mjModel* m, mjData* d, gsKneeLoads* out) {
+  const gsKneeModel* cached = gs_knee_lookup(m);
+  if (!cached && register_model(m, 1, NULL, 0) == 1) {
+    cached = gs_knee_lookup(m);  // registered now (by this thread or another one)
+  }
+  if (cached) {
+    gs_knee_passive_model(cached, m, d, out);
+    return 1;
+  }
   gsKneeModel km;
   int rc = gs_knee_model_init(m, &km, NULL, 0);
   if (rc != 1) {

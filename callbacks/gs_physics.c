@@ -193,7 +193,8 @@ void gs_physics_foot_grf(const mjModel* m, const mjData* d, int side, double fn_
 }
 
 // mjcb_passive: foot-ground contact, and the implant knee's surrogate contact and ligaments when
-// the model carries the gs_knee numerics (callbacks/gs_knee.h; a no-op otherwise)
+// the model carries the gs_knee numerics (callbacks/gs_knee.h; a no-op otherwise; the knee's
+// parameters were cached by gs_physics_prepare, gs_knee_register)
 static void gs_passive_callback(const mjModel* m, mjData* d) {
   gs_physics_contact_passive(m, d);
   gs_knee_passive(m, d, NULL);
@@ -244,6 +245,13 @@ int gs_physics_prepare(mjModel* m, char* err, int errsz) {
   m->opt.disableflags |= mjDSBL_CONTACT;
   if (m->nuserdata < GS_USERDATA_SIZE(m)) {
     m->nuserdata = GS_USERDATA_SIZE(m);
+  }
+  // implant knee: numerics checked and cached once here, so that mjcb_passive finds them by the
+  // model pointer instead of by name on every call (gs_knee_register; no-op for other models)
+  char why[256];
+  if (gs_knee_register(m, why, sizeof(why)) < 0) {
+    snprintf(err, errsz, "%s", why);
+    return -1;
   }
   return 0;
 }

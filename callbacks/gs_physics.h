@@ -28,8 +28,10 @@
 
 // Switch model m to gaitsim's physics: gaitsim muscles get user gain, bias and dynamics; MuJoCo's
 // contact solver is disabled (the spheres become ours); nuserdata grows to GS_USERDATA_SIZE.
-// Checks every muscle's and contact sphere's parameters. Call before mj_makeData. Returns 0, or
-// -1 with the reason (naming the actuator or geom) in err.
+// Checks every muscle's and contact sphere's parameters. A model with implant-knee numerics
+// (gs_knee_*) has them checked and registered once here (gs_knee.h), so the passive callback
+// does no name look-ups; inconsistent numerics fail. Call before mj_makeData. Returns 0, or -1
+// with the reason (naming the actuator, geom or numeric) in err.
 int gs_physics_prepare(mjModel* m, char* err, int errsz);
 
 // Install the callbacks (process-global). Call once, before threads start. Idempotent.

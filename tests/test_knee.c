@@ -1,8 +1,11 @@
 // test_knee.c: implant-knee contact and ligaments (callbacks/gs_knee.h): elastic foundation
 // against the analytic sphere on a thin layer, C elastic foundation against the Python reference,
 // surrogate against the elastic foundation on held-out poses, finite-difference smoothness of the
-// surrogate, and the knee fixture loaded by 2 BW compression settling to a plausible pose.
+// surrogate, the per-model cache (gs_knee_register / gs_knee_lookup, also from several threads),
+// ligament lengthening speeds against finite differences, and the knee fixture loaded by 2 BW
+// compression settling to a plausible pose.
 #include <math.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,7 +21,7 @@
 #define FIXTURE GAITSIM_SOURCE_DIR "/tests/fixtures/knee6.xml"
 #define HELDOUT GAITSIM_SOURCE_DIR "/mjmodels/knee/jw_knee_heldout.csv"
 #define EF_MESH GAITSIM_SOURCE_DIR "/mjmodels/knee/jw_knee_ef_mesh.txt"
-#define MAXROWS 64
+#define MAXROWS 256             // the held-out table has 200 rows
 #define BW 614.25               // JW's body weight, 62.636 kg x 9.80665 m/s^2   (N)
 
 // insert material of the Grand Challenge TKA (DM_tka_ligaments.osim): E, nu, h
@@ -286,19 +289,20 @@ static void test_surrogate_heldout(const gsKneeModel* km, double rows[MAXROWS][1
     }
   }
 
-  // RMS per component as % of its peak. Issue #7 targets 3 %; the present surrogate does NOT
-  // meet it (mjmodels/knee/README.md), so these bounds only guard the present fit against
-  // regressions: |F| per compartment within 15 %, every component within 35 %.
+  // RMS per component as % of its peak over the held-out table. Issue #7 targets <= 3 %. Reached
+  // (2026-12-01, mjmodels/knee/README.md): |F| 0.48 % medial, 0.50 % lateral; components
+  // 0.39-1.31 % (the largest: lateral Fx and My, whose held-out peaks are small). These bounds
+  // guard what was reached: |F| within 0.75 %, every component within 1.5 %.
   const char* names[6] = {"Fx", "Fy", "Fz", "Mx", "My", "Mz"};
   for (int c = 0; c < 2; c++) {
     double pct = 100.0 * sqrt(ss_mag[c] / nrows) / peak_mag[c];
-    printf("surrogate %s |F|: RMS %.2f %% of peak %.0f N\n", c ? "lateral" : "medial", pct,
-           peak_mag[c]);
-    EXPECT_TRUE(pct <= 15.0);
+    printf("surrogate %s |F|: RMS %.2f %% of peak %.0f N (%d held-out poses)\n",
+           c ? "lateral" : "medial", pct, peak_mag[c], nrows);
+    EXPECT_TRUE(pct <= 0.75);
     for (int i = 0; i < 6; i++) {
       double p = 100.0 * sqrt(ss[6 * c + i] / nrows) / peak[6 * c + i];
       printf("  %s: RMS %.2f %% of peak %.3g\n", names[i], p, peak[6 * c + i]);
-      EXPECT_TRUE(p <= 35.0);
+      EXPECT_TRUE(p <= 1.5);
     }
   }
 }
@@ -306,7 +310,11 @@ static void test_surrogate_heldout(const gsKneeModel* km, double rows[MAXROWS][1
 // ---- finite-difference smoothness of the surrogate ----------------------------------------
 // central differences with steps h and h/2 agree (the derivative exists and is continuous at the
 // scale of the steps): |D(h) - D(h/2)| <= 2 % of max(|D|, floor), for all 6 x 6 force/moment
-// derivatives at the held-out poses; h = 2e-5 rad, 1e-6 m (below the 5 um ramp width).
+// derivatives at 20 held-out poses; h = 2e-5 rad, 1e-6 m (below the 5 um ramp width). floor: 1 %
+// of the coordinate's largest derivative, and at least a change of 0.01 N (0.5 mN m for moments)
+// per 1 um of motion (per 2.5e-5 rad, 1 um at 40 mm): at poses without contact the surrogate's
+// compactly supported ramp leaves forces of 1e-4 N whose relative derivatives are large but
+// physically nil (3e-6 of the peak loads).
 static void fd_derivs(const gsKneeModel* km, const double q0[6], int i, double h, double D[12]) {
   double qp[6], qm[6];
   gsKneeContact op, om;
@@ -334,14 +342,15 @@ static void test_surrogate_fd_smooth(const gsKneeModel* km, double rows[MAXROWS]
       double D1[12], D2[12];
       fd_derivs(km, rows[r], i, h, D1);
       fd_derivs(km, rows[r], i, 0.5 * h, D2);
-      // floor: 1 % of the largest derivative of this coordinate
+      // floor: 1 % of the largest derivative of this coordinate, and the absolute floor above
       double floor = 0.0;
       for (int k = 0; k < 12; k++) {
         floor = fmax(floor, 0.01 * fabs(D2[k]));
       }
-      floor = fmax(floor, 1e-6);
+      double abs_floor = i < 3 ? 0.01 / 2.5e-5 : 0.01 / 1e-6;   // N/rad, N/m
       for (int k = 0; k < 12; k++) {
-        double rel = fabs(D1[k] - D2[k]) / fmax(fabs(D2[k]), floor);
+        double fl = fmax(floor, (k % 6) < 3 ? abs_floor : 0.05 * abs_floor);
+        double rel = fabs(D1[k] - D2[k]) / fmax(fabs(D2[k]), fl);
         worst = rel > worst ? rel : worst;
         bad += rel > 0.02;
         checked++;
@@ -502,6 +511,221 @@ static void test_fixture(const mjModel* m, const gsKneeModel* km) {
   mj_deleteData(d);
 }
 
+// ---- per-model cache (gs_knee_register, gs_knee_lookup) ----------------------------------
+// Not registered: lookup NULL; gs_knee_passive registers it on its first call. Registered: lookup
+// returns the entry and gs_knee_passive gives exactly what gs_knee_passive_model gives with a
+// fresh gs_knee_model_init. A copy of the model (another pointer) is not found until used. A
+// model without the numerics registers as 0. Several threads evaluating one model with their own
+// mjData while the main thread registers other models (evicting slots, so that the threads
+// re-register it) get the serial result bit for bit.
+#define CACHE_THREADS 3
+#define CACHE_EVALS 300
+typedef struct {
+  const mjModel* m;
+  const double* qpos;
+  const double* qvel;
+  double expect[6];
+  int mismatches;
+} cacheJob;
+
+static void* cache_worker(void* arg) {
+  cacheJob* job = arg;
+  mjData* d = mj_makeData(job->m);
+  mju_copy(d->qpos, job->qpos, job->m->nq);
+  mju_copy(d->qvel, job->qvel, job->m->nv);
+  mj_kinematics(job->m, d);
+  mj_comPos(job->m, d);
+  mj_comVel(job->m, d);
+  for (int k = 0; k < CACHE_EVALS; k++) {
+    gsKneeLoads loads;
+    if (gs_knee_passive(job->m, d, &loads) != 1) {
+      job->mismatches++;
+      continue;
+    }
+    for (int i = 0; i < 6; i++) {
+      job->mismatches += loads.qfrc[i] != job->expect[i];
+    }
+  }
+  mj_deleteData(d);
+  return NULL;
+}
+
+static void test_cache(const mjModel* m0) {
+  char err[300];
+  mjModel* m = mj_copyModel(NULL, m0);
+  mjData* d = mj_makeData(m);
+  const gsKneeModel* km_reg;
+  gsKneeModel km;
+  EXPECT_TRUE(gs_knee_lookup(m) == NULL);
+  EXPECT_EQ_INT(1, gs_knee_model_init(m, &km, err, sizeof(err)));
+
+  // a loaded pose with velocities: contact, ligaments and damping all act
+  d->qpos[km.qadr[GS_KNEE_FLEX]] = -0.4;
+  d->qpos[km.qadr[GS_KNEE_TY]] = 0.0428;
+  for (int i = 0; i < 6; i++) {
+    d->qvel[km.dadr[i]] = 0.3 * (i - 2.5);
+  }
+  mj_kinematics(m, d);
+  mj_comPos(m, d);
+  mj_comVel(m, d);
+  gsKneeLoads by_name, by_model, cached;
+  mju_zero(d->qfrc_passive, m->nv);
+  gs_knee_passive_model(&km, m, d, &by_model);
+  EXPECT_EQ_INT(1, gs_knee_passive(m, d, &by_name));   // registers m
+  EXPECT_TRUE(gs_knee_lookup(m) != NULL);
+  EXPECT_TRUE(by_name.contact.total > 100.0);
+  EXPECT_TRUE(by_name.ligament_force > 1.0);
+
+  EXPECT_EQ_INT(1, gs_knee_register(m, err, sizeof(err)));
+  km_reg = gs_knee_lookup(m);
+  EXPECT_TRUE(km_reg != NULL);
+  EXPECT_EQ_INT(1, gs_knee_passive(m, d, &cached));
+  for (int i = 0; i < 6; i++) {
+    EXPECT_NEAR(by_model.qfrc[i], by_name.qfrc[i], 0.0);
+    EXPECT_NEAR(by_model.qfrc[i], cached.qfrc[i], 0.0);
+  }
+  // registering again replaces the entry; a copy is another model
+  EXPECT_EQ_INT(1, gs_knee_register(m, err, sizeof(err)));
+  EXPECT_TRUE(gs_knee_lookup(m) != NULL);
+  mjModel* copy = mj_copyModel(NULL, m);
+  EXPECT_TRUE(gs_knee_lookup(copy) == NULL);
+
+  // a cached number changed in place (the medial gain, gs_knee_femur header index 12): the entry
+  // no longer matches, the next call re-registers and uses the new number
+  {
+    mjData* dc = mj_makeData(copy);
+    mju_copy(dc->qpos, d->qpos, m->nq);
+    mj_kinematics(copy, dc);
+    mj_comPos(copy, dc);
+    EXPECT_EQ_INT(1, gs_knee_register(copy, err, sizeof(err)));
+    EXPECT_TRUE(gs_knee_lookup(copy) != NULL);
+    gsKneeLoads l1, l2;
+    EXPECT_EQ_INT(1, gs_knee_passive(copy, dc, &l1));
+    int id = mj_name2id(copy, mjOBJ_NUMERIC, "gs_knee_femur_0");
+    EXPECT_TRUE(id >= 0);
+    if (id >= 0) {
+      copy->numeric_data[copy->numeric_adr[id] + 12] *= 2.0;
+      EXPECT_TRUE(gs_knee_lookup(copy) == NULL);
+      EXPECT_EQ_INT(1, gs_knee_passive(copy, dc, &l2));
+      EXPECT_TRUE(gs_knee_lookup(copy) != NULL);
+      EXPECT_TRUE(l1.contact.magnitude[0] > 10.0);
+      EXPECT_REL(2.0 * l1.contact.magnitude[0], l2.contact.magnitude[0], 1e-12, 1e-9);
+      EXPECT_REL(l1.contact.magnitude[1], l2.contact.magnitude[1], 1e-12, 1e-9);
+    }
+    mj_deleteData(dc);
+  }
+
+  // a model without the numerics
+  mjModel* plain = mj_loadXML(GAITSIM_SOURCE_DIR "/tests/fixtures/one_muscle.xml", NULL, err,
+                              sizeof(err));
+  if (plain) {
+    EXPECT_EQ_INT(0, gs_knee_register(plain, err, sizeof(err)));
+    EXPECT_TRUE(gs_knee_lookup(plain) == NULL);
+  }
+
+  // threads: evaluate m while other models are registered (and evict slots)
+  cacheJob jobs[CACHE_THREADS];
+  pthread_t th[CACHE_THREADS];
+  for (int k = 0; k < CACHE_THREADS; k++) {
+    jobs[k].m = m;
+    jobs[k].qpos = d->qpos;
+    jobs[k].qvel = d->qvel;
+    memcpy(jobs[k].expect, cached.qfrc, sizeof(jobs[k].expect));
+    jobs[k].mismatches = 0;
+    EXPECT_EQ_INT(0, pthread_create(&th[k], NULL, cache_worker, &jobs[k]));
+  }
+  mjModel* others[GS_KNEE_CACHE_SLOTS + 2];
+  for (int k = 0; k < GS_KNEE_CACHE_SLOTS + 2; k++) {
+    others[k] = mj_copyModel(NULL, m0);
+    EXPECT_EQ_INT(1, gs_knee_register(others[k], err, sizeof(err)));
+  }
+  for (int k = 0; k < CACHE_THREADS; k++) {
+    pthread_join(th[k], NULL);
+    EXPECT_EQ_INT(0, jobs[k].mismatches);
+  }
+  // the newest registration is found; m, evicted or re-registered by the threads, gives the
+  // same loads and is found afterwards
+  EXPECT_TRUE(gs_knee_lookup(others[GS_KNEE_CACHE_SLOTS + 1]) != NULL);
+  EXPECT_EQ_INT(1, gs_knee_passive(m, d, &by_name));
+  EXPECT_TRUE(gs_knee_lookup(m) != NULL);
+  for (int i = 0; i < 6; i++) {
+    EXPECT_NEAR(cached.qfrc[i], by_name.qfrc[i], 0.0);
+  }
+  for (int k = 0; k < GS_KNEE_CACHE_SLOTS + 2; k++) {
+    mj_deleteModel(others[k]);
+  }
+  if (plain) {
+    mj_deleteModel(plain);
+  }
+  mj_deleteModel(copy);
+  mj_deleteData(d);
+  mj_deleteModel(m);
+}
+
+// ---- ligament lengthening speeds ------------------------------------------------------------
+// The damping part of the summed bundle tension, ligament_force(qvel) - ligament_force(0),
+// equals sum_b c_b (dL_b/dt / l0_b) s(e_b) with dL/dt from central differences of the bundle
+// lengths along qvel (mj_integratePos), to 1e-6 relative.
+static double bundle_length(const mjModel* m, const mjData* d, const gsKneeModel* km, int b) {
+  const mjtNum* row = km->lig + GS_KNEE_NLIG * b;
+  mjtNum pf[3], pt[3];
+  mju_mulMatVec(pf, d->xmat + 9 * km->body_fem, row, 3, 3);
+  mju_mulMatVec(pt, d->xmat + 9 * km->body_tib, row + 3, 3, 3);
+  for (int i = 0; i < 3; i++) {
+    pf[i] += d->xpos[3 * km->body_fem + i];
+    pt[i] += d->xpos[3 * km->body_tib + i];
+  }
+  return mju_dist3(pf, pt);
+}
+
+static void test_ligament_speed(const mjModel* m, const gsKneeModel* km) {
+  mjData* d = mj_makeData(m);
+  mjData* dp = mj_makeData(m);
+  mjData* dm = mj_makeData(m);
+  d->qpos[km->qadr[GS_KNEE_FLEX]] = -0.5;
+  d->qpos[km->qadr[GS_KNEE_TY]] = 0.0432;   // ligaments taut around the default pose
+  const double v[6] = {0.8, -0.3, 0.5, 0.02, -0.05, 0.03};
+  for (int i = 0; i < 6; i++) {
+    d->qvel[km->dadr[i]] = v[i];
+  }
+  mj_kinematics(m, d);
+  mj_comPos(m, d);
+  mj_comVel(m, d);
+  gsKneeLoads moving, still;
+  gs_knee_passive_model(km, m, d, &moving);
+  mju_zero(d->qvel, m->nv);
+  mj_comVel(m, d);
+  gs_knee_passive_model(km, m, d, &still);
+  for (int i = 0; i < 6; i++) {
+    d->qvel[km->dadr[i]] = v[i];
+  }
+  const double dt = 1e-6;
+  mju_copy(dp->qpos, d->qpos, m->nq);
+  mju_copy(dm->qpos, d->qpos, m->nq);
+  mj_integratePos(m, dp->qpos, d->qvel, 0.5 * dt);
+  mj_integratePos(m, dm->qpos, d->qvel, -0.5 * dt);
+  mj_kinematics(m, dp);
+  mj_kinematics(m, dm);
+  double expect = 0.0, scale = 0.0;
+  for (int b = 0; b < km->nlig; b++) {
+    const mjtNum* row = km->lig + GS_KNEE_NLIG * b;
+    double len = bundle_length(m, d, km, b);
+    double speed = (bundle_length(m, dp, km, b) - bundle_length(m, dm, km, b)) / dt;
+    double e = len / row[7] - 1.0, wdt = 0.05 * row[8];
+    double term = row[9] * (speed / row[7]) * 0.5 * (1.0 + e / sqrt(e * e + wdt * wdt));
+    expect += term;
+    scale += fabs(term);
+  }
+  double got = moving.ligament_force - still.ligament_force;
+  printf("ligament damping: %.6g N from the callback, %.6g N from finite-difference speeds\n",
+         got, expect);
+  EXPECT_TRUE(scale > 1e-3);
+  EXPECT_NEAR(expect, got, 1e-6 * scale + 1e-12);
+  mj_deleteData(dm);
+  mj_deleteData(dp);
+  mj_deleteData(d);
+}
+
 // ---- ligament law -------------------------------------------------------------------------
 static void test_ligament_law(void) {
   // k 2000 N/strain, l0 0.05 m, et 0.06, c 0.003: slack, toe, linear against the hard law
@@ -528,7 +752,7 @@ static void test_ligament_law(void) {
 // tibia is pressed into the femoral component, so the knee_ty generalized force pushes the two
 // apart (> 0 along the axis, which points from the femoral component to the tibial tray) and
 // equals the generalized force gs_knee_passive reports (1e-9 N); with knee_ty 10 mm above
-// (distraction) the contact force is below 0.1 N (the smooth ramp gs_knee_ramp leaves 0.05 N).
+// (distraction) the contact force is exactly 0 (the surrogate's ramp vanishes below -40 um).
 // Foot contact is far off the floor (pelvis raised).
 static void test_full_model_passive(void) {
   char err[300];
@@ -559,7 +783,7 @@ static void test_full_model_passive(void) {
       EXPECT_NEAR(loads.qfrc[GS_KNEE_TY], applied, 1e-9);
       EXPECT_TRUE(loads.contact.magnitude[0] + loads.contact.magnitude[1] > 10.0);
     } else {
-      EXPECT_NEAR(0.0, loads.contact.magnitude[0] + loads.contact.magnitude[1], 0.1);  // smooth ramp
+      EXPECT_NEAR(0.0, loads.contact.magnitude[0] + loads.contact.magnitude[1], 0.0);
     }
   }
   mj_deleteData(d);
@@ -587,6 +811,8 @@ int main(void) {
     test_surrogate_fd_smooth(&km, rows, nrows);
   }
   test_fixture(m, &km);
+  test_cache(m);
+  test_ligament_speed(m, &km);
 
   // a model without the numerics is left alone
   {

@@ -195,14 +195,29 @@ int gs_cmd_sweep(int argc, char** argv) {
     rc_down = chain(guess, v, down, nd, dir, nodes, max_time, max_iter);
   }
 
-  // the table
-  char csv[16384], md[16384], path[4200], sol[4096];
+  // the table; changes against the guess (the tracking solution: the paper's comparison) and the
+  // right triceps surae's peak excitations (summary.json peak_excitation)
+  double T0 = NAN, L0 = NAN;
+  char sol[4096];
+  {
+    snprintf(sol, sizeof(sol), "%s/summary.json", guess);
+    cJSON* j = gs_app_read_json(sol);
+    const cJSON* t = cJSON_GetObjectItemCaseSensitive(j, "stride_time_s");
+    if (cJSON_IsNumber(t)) T0 = t->valuedouble, L0 = v0 * T0;
+    cJSON_Delete(j);
+  }
+  char csv[16384], md[16384], path[4200];
   int lc = snprintf(csv, sizeof(csv), "speed_mps,stride_time_s,stride_length_m,"
+                    "stride_time_change_pct,stride_length_change_pct,"
                     "cost_of_transport_j_per_kg_m,peak_vertical_grf_bw,peak_knee_contact_r_bw,"
-                    "peak_knee_contact_l_bw,status\n");
-  int lm = snprintf(md, sizeof(md), "| speed (m/s) | stride time (s) | stride length (m) | cost of "
-                    "transport (J/(kg m)) | peak vertical GRF (BW) | peak knee contact, right (BW) "
-                    "| peak knee contact, left (BW) | status |\n|---|---|---|---|---|---|---|---|\n");
+                    "peak_knee_contact_l_bw,peak_soleus_excitation,peak_gastrocnemius_excitation,"
+                    "status\n");
+  int lm = snprintf(md, sizeof(md), "| speed (m/s) | stride time (s) | stride length (m) | "
+                    "change from the guess: time, length (%%) | cost of transport (J/(kg m)) | "
+                    "peak vertical GRF (BW) | peak knee contact, right (BW) | peak knee contact, "
+                    "left (BW) | peak excitation: soleus, gastrocnemius | status |\n"
+                    "|---|---|---|---|---|---|---|---|---|---|\n");
+  double sol_ex[SWEEP_MAX_SPEEDS], gas_ex[SWEEP_MAX_SPEEDS];
   for (int i = 0; i < n; i++) {
     snprintf(sol, sizeof(sol), "%s/predict_%.4g", dir, v[i]);
     snprintf(path, sizeof(path), "%s/summary.json", sol);
@@ -216,20 +231,41 @@ int gs_cmd_sweep(int argc, char** argv) {
     }
     const cJSON* st = cJSON_GetObjectItemCaseSensitive(j, "status");
     const char* status = cJSON_IsString(st) ? st->valuestring : "missing";
+    // right leg: soleus; gastrocnemius the larger of its heads (JW's right-leg names)
+    const cJSON* pe = cJSON_GetObjectItemCaseSensitive(j, "peak_excitation");
+    const cJSON* so = cJSON_GetObjectItemCaseSensitive(pe, "soleus");
+    const cJSON* gm = cJSON_GetObjectItemCaseSensitive(pe, "gasmed");
+    const cJSON* gl = cJSON_GetObjectItemCaseSensitive(pe, "gaslat");
+    sol_ex[i] = cJSON_IsNumber(so) ? so->valuedouble : NAN;
+    gas_ex[i] = fmax(cJSON_IsNumber(gm) ? gm->valuedouble : NAN,
+                     cJSON_IsNumber(gl) ? gl->valuedouble : NAN);
     double bw = f[3];  // the model's weight (N)
     double grf = fmax(column_max(sol, "grf.mot", "ground_force_r_vy"),
                       column_max(sol, "grf.mot", "ground_force_l_vy")) / bw;
     double knee = column_max(sol, "knee_contact.sto", "contact_total_r") / bw;
     double knee_l = column_max(sol, "knee_contact.sto", "contact_total_l") / bw;
+    double dT = 100 * (f[0] / T0 - 1), dL = 100 * (f[1] / L0 - 1);
     if (lc < (int)sizeof(csv))
-      lc += snprintf(csv + lc, sizeof(csv) - (size_t)lc, "%.4g,%.4f,%.4f,%.3f,%.3f,%.3f,%.3f,%s\n",
-                     v[i], f[0], f[1], f[2], grf, knee, knee_l, status);
+      lc += snprintf(csv + lc, sizeof(csv) - (size_t)lc,
+                     "%.4g,%.4f,%.4f,%.2f,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%s\n", v[i], f[0], f[1],
+                     dT, dL, f[2], grf, knee, knee_l, sol_ex[i], gas_ex[i], status);
     if (lm < (int)sizeof(md))
       lm += snprintf(md + lm, sizeof(md) - (size_t)lm,
-                     "| %.4g | %.3f | %.3f | %.2f | %.2f | %.2f | %.2f | %s |\n", v[i], f[0], f[1],
-                     f[2], grf, knee, knee_l, status);
+                     "| %.4g | %.3f | %.3f | %+.1f, %+.1f | %.2f | %.2f | %.2f | %.2f | %.2f, %.2f "
+                     "| %s |\n",
+                     v[i], f[0], f[1], dT, dL, f[2], grf, knee, knee_l, sol_ex[i], gas_ex[i],
+                     status);
     cJSON_Delete(j);
   }
+  // Lin, Walter & Pandy 2018 report peak soleus and gastrocnemius excitations about 2.5 times
+  // higher at 2.0 than at 0.8 m/s: the same ratio between the fastest and slowest speed here
+  if (n >= 2 && lm < (int)sizeof(md))
+    lm += snprintf(md + lm, sizeof(md) - (size_t)lm,
+                   "\nFast/slow peak excitation ratio (%.4g vs %.4g m/s): soleus %.2f, "
+                   "gastrocnemius %.2f (paper: about 2.5). Changes are against the guess %s "
+                   "(stride %.3f s, %.3f m).\n",
+                   v[n - 1], v[0], sol_ex[n - 1] / sol_ex[0], gas_ex[n - 1] / gas_ex[0], guess,
+                   T0, L0);
   snprintf(path, sizeof(path), "%s/sweep.csv", dir);
   int ok = gs_atomic_write_buffer(path, csv, strlen(csv), err, sizeof(err)) == 0;
   snprintf(path, sizeof(path), "%s/sweep.md", dir);

@@ -33,6 +33,19 @@ ok = len(rows) == 2 and all(math.isfinite(float(r[k])) and float(r[k]) > 0
 sys.exit(0 if ok else 1)
 PY
 check "markdown: left knee column" grep -q '| peak knee contact, left (BW) |' sw/sweep.md
+check "markdown: change and excitation columns, ratio line" grep -q "change from the guess: time, length" sw/sweep.md
+check "markdown: fast/slow excitation ratio" grep -q "^Fast/slow peak excitation ratio" sw/sweep.md
+check "csv: changes against the guess's stride, excitations in (0, 1]" /usr/bin/python3 - sw/sweep.csv guess/summary.json <<'PY'
+import csv, json, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+g = json.load(open(sys.argv[2]))
+T0 = g["stride_time_s"]; L0 = g["speed_mps"] * T0
+ok = all(abs(float(r["stride_time_change_pct"]) - 100 * (float(r["stride_time_s"]) / T0 - 1)) < 0.01 and
+         abs(float(r["stride_length_change_pct"]) - 100 * (float(r["stride_length_m"]) / L0 - 1)) < 0.02 and
+         0 < float(r["peak_soleus_excitation"]) <= 1 and 0 < float(r["peak_gastrocnemius_excitation"]) <= 1
+         for r in rows)
+sys.exit(0 if ok and rows else 1)
+PY
 "$gaitsim" sweep --guess guess --speeds 0.8:x:2 --out sw2 >/dev/null 2>&1
 check "malformed speeds: exit 2" test $? -eq 2
 finish

@@ -231,8 +231,9 @@ static double normalise_grf_to_weight(gsTable* grf, double weight) {
 }
 
 // Right (implant) knee contact forces (N) at the loaded state d into f = {medial, lateral, total}.
-// A model with the gs_knee numerics (callbacks/gs_knee.h): the surrogate's compartment force
-// magnitudes (d->qfrc_passive gains the knee loads once more: d is scratch). The placeholder knee
+// A model with the gs_knee numerics (callbacks/gs_knee.h): the surrogate's compartment forces'
+// axial (compressive) components in the tibial_tray frame, as the eTibia measures them
+// (d->qfrc_passive gains the knee loads once more: d is scratch). The placeholder knee
 // (a stiff spring-damper on knee_ty, mjmodels/README.md): total only, the spring-damper force
 // -(k (q - q_spring) + b qdot) along the joint axis, which points from the femoral component to
 // the tibial tray (-y of the femoral component), so compression gives a positive force; medial
@@ -241,8 +242,11 @@ static void knee_contact(const mjModel* m, mjData* d, double f[3]) {
   f[0] = f[1] = f[2] = NAN;
   gsKneeLoads loads;
   if (gs_knee_passive(m, d, &loads) == 1) {
-    f[0] = loads.contact.magnitude[0];
-    f[1] = loads.contact.magnitude[1];
+    // what the eTibia's load cells measure (Fregly et al. 2012): the axial component, along the
+    // tibial_tray y axis (the tray's long axis); the surrogate's force on the tibia points -y in
+    // compression. Shear (the posterior slope, roll-back) is left out as in the measurement.
+    f[0] = -loads.contact.force[0][1];
+    f[1] = -loads.contact.force[1][1];
     f[2] = f[0] + f[1];
     return;
   }

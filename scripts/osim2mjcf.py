@@ -4,8 +4,8 @@
 Reads JW_AllBody_scaled.osim (OpenSim 4.0 document format, gait2392-family muscles) and the
 muscle_params folder, writes one MJCF file that follows callbacks/gs_model_layout.h, and a
 reference table of muscle-tendon lengths and moment arms computed from the OpenSim geometry
-alone (CustomJoint kinematics, path points incl. conditional and moving points, straight
-segments, no wrapping) for the project's C test.
+alone (CustomJoint kinematics, path points incl. conditional and moving points; straight
+segments, and with OpenSim's wrapping re-implemented: wrapped_path) for the project's C test.
 
 Standard library only. Deterministic: the same inputs give the same bytes.
 
@@ -644,6 +644,693 @@ def moment_arms(model, muscle, pose, coordinates):
         lo[c] -= FD_STEP
         hi[c] += FD_STEP
         out[c] = -(path_length(model, muscle, hi) - path_length(model, muscle, lo)) / (2 * FD_STEP)
+    return out
+
+
+# ------------------------------------------------------------------------------------------------
+# OpenSim wrapping (reference only; the MJCF uses MuJoCo's own wrapping, wrap_geom_spec)
+#
+# A port of OpenSim 4's path wrapping (opensim-org/opensim-core, Apache-2.0, Peter Loan / SIMM):
+# GeometryPath::applyWrapObjects (order of PathWraps, point range, segment choice, iteration),
+# WrapObject::wrapPathSegment (frames), WrapEllipsoid::wrapLine (hybrid/midpoint wrapping plane,
+# calcTangentPoint, CalcDistanceOnEllipsoid, findClosestPoint / closestPointToEllipse after
+# Eberly, Graphics Gems IV) and WrapCylinder::wrapLine (quadrant/active-side rule, tangent-point
+# candidates, far-side and long wraps, display-length rule). Deliberate differences, all so that
+# central differences of the length (h = FD_STEP) are smooth (mjmodels/README.md, "Wrapped
+# reference"): the tangent-point and closest-point iterations are polished to machine precision
+# (OpenSim stops at ssq < 1e-8 resp. |f| < 1e-9); the ellipsoid arc is summed over
+# WRAP_ARC_SEGMENTS chords instead of 1-mm chords; the cylinder's spiral is the exact geodesic
+# (straight in the developed surface: the limit of OpenSim's _adjust_tangent_point iteration,
+# which stops at 0.1 deg); several PathWraps are iterated to a fixed point (|dL| < WRAP_ITER_TOL)
+# instead of stopping at 0.5 mm. WrapSphere and WrapTorus are not used by JW's model and not
+# implemented (an error names them).
+# ------------------------------------------------------------------------------------------------
+
+WRAP_NO, WRAP_INSIDE, WRAP_WRAPPED, WRAP_MANDATORY = 0, 1, 2, 3   # OpenSim WrapObject::WrapAction
+WRAP_ARC_SEGMENTS = 400      # chords of the ellipsoid arc (OpenSim: 1 mm each, at most 499)
+WRAP_ITER_TOL = 1e-12        # fixed-point tolerance of several PathWraps (m; OpenSim 0.0005)
+WRAP_ITER_MAX = 60           # iterations at most (OpenSim 8)
+ELL_MU_BLEND_MIN = 0.7073    # WrapEllipsoid.cpp MU_BLEND_MIN (100 % fan)
+ELL_MU_BLEND_MAX = 0.9       # MU_BLEND_MAX (100 % Frans)
+ELL_FAN_SAMPLES = 300        # NUM_FAN_SAMPLES
+ELL_SV_BOUNDARY_BLEND = 0.3  # SV_BOUNDARY_BLEND
+ROUNDOFF_ERROR = 2e-13       # SimmMacros.h EQUAL_WITHIN_ERROR
+
+
+def dot3(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def cross3(a, b):
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+def unit_or_zero(a):
+    n = vec_norm(a)
+    return [x / n for x in a] if n > 0.0 else [0.0, 0.0, 0.0]
+
+
+def dsign(x):
+    return 1 if x >= 0.0 else -1
+
+
+def solve_linear(a, b):
+    """Solve a x = b (Gaussian elimination with partial pivoting, small dense systems)."""
+    n = len(b)
+    m = [list(a[i]) + [b[i]] for i in range(n)]
+    for c in range(n):
+        p = max(range(c, n), key=lambda r: abs(m[r][c]))
+        m[c], m[p] = m[p], m[c]
+        if m[c][c] == 0.0:
+            raise ZeroDivisionError("singular system")
+        for r in range(c + 1, n):
+            f = m[r][c] / m[c][c]
+            for k in range(c, n + 1):
+                m[r][k] -= f * m[c][k]
+    x = [0.0] * n
+    for r in range(n - 1, -1, -1):
+        x[r] = (m[r][n] - sum(m[r][k] * x[k] for k in range(r + 1, n))) / m[r][r]
+    return x
+
+
+def wrap_quadrant(w):
+    """(wrap axis, wrap sign) of OpenSim's quadrant (WrapObject::extendFinalizeFromProperties);
+    sign 0 for 'all'."""
+    d = quadrant_direction(w)
+    if d is None:
+        return 0, 0
+    k = [i for i in range(3) if d[i] != 0.0][0]
+    return k, int(d[k])
+
+
+def closest_point_to_ellipse(a, b, u, v):
+    """WrapEllipsoid::closestPointToEllipse (Eberly): point (x, y) of (x/a)^2 + (y/b)^2 = 1
+    closest to (u, v)."""
+    a2, b2 = a * a, b * b
+    a2u2, b2v2 = a2 * u * u, b2 * v * v
+    near_x, near_y = abs(u) <= ROUNDOFF_ERROR, abs(v) <= ROUNDOFF_ERROR
+    if near_x and near_y:
+        return ((-a if u < 0.0 else a), v) if a < b else (u, (-b if v < 0.0 else b))
+    if near_x:
+        if a >= b or abs(v) >= b - a2 / b:
+            return u, (b if v >= 0 else -b)
+        y = b2 * v / (b2 - a2)
+        return a * math.sqrt(abs(1 - (y / b) ** 2)), y
+    if near_y:
+        if b >= a or abs(u) >= a - b2 / a:
+            return (a if u >= 0 else -a), v
+        x = a2 * u / (a2 - b2)
+        return x, b * math.sqrt(abs(1 - (x / a) ** 2))
+    t = 0.0 if (u / a) ** 2 + (v / b) ** 2 < 1.0 else max(a, b) * math.sqrt(u * u + v * v)
+    extra = 0
+    for _ in range(64 + 3):
+        p, q = t + a2, t + b2
+        f = p * p * q * q - a2u2 * q * q - b2v2 * p * p
+        if abs(f) < 1e-9:
+            extra += 1          # polish: a few Newton steps past OpenSim's stopping test
+            if extra > 3:
+                break
+        fp = 2.0 * (p * q * (p + q) - a2u2 * q - b2v2 * p)
+        if fp == 0.0:
+            break
+        t -= f / fp
+    p, q = t + a2, t + b2
+    return a2 * u / p, b2 * v / q
+
+
+def ellipsoid_closest_point(a, pt, special=-1):
+    """WrapEllipsoid::findClosestPoint: point of the ellipsoid with semi-axes a (centred, axis
+    aligned) closest to pt; near a coordinate plane (or with special = that axis) the 2-d
+    cross-section is used."""
+    u = list(pt)
+    if special < 0:
+        best = float("inf")
+        for i in range(3):
+            if abs(u[i]) <= ROUNDOFF_ERROR:
+                s = sum(a[j] for j in range(3) if j != i)
+                if best > s:
+                    special, best = i, s
+    if special == 0:
+        y, z = closest_point_to_ellipse(a[1], a[2], u[1], u[2])
+        return [u[0], y, z]
+    if special == 1:
+        z, x = closest_point_to_ellipse(a[2], a[0], u[2], u[0])
+        return [x, u[1], z]
+    if special == 2:
+        x, y = closest_point_to_ellipse(a[0], a[1], u[0], u[1])
+        return [x, y, u[2]]
+    a2 = [x * x for x in a]
+    c = [a2[i] * u[i] * u[i] for i in range(3)]
+    if sum((u[i] / a[i]) ** 2 for i in range(3)) < 1.0:
+        t = 0.0
+    else:
+        t = max(a) * vec_norm(u)
+    extra = 0
+    for _ in range(64 + 3):
+        p, q, r = t + a2[0], t + a2[1], t + a2[2]
+        f = (p * p * q * q * r * r - c[0] * q * q * r * r - c[1] * p * p * r * r
+             - c[2] * p * p * q * q)
+        if abs(f) < 1e-9:
+            extra += 1
+            if extra > 3:
+                break
+        fp = 2.0 * (p * q * r * (q * r + p * r + p * q) - c[0] * q * r * (q + r)
+                    - c[1] * p * r * (p + r) - c[2] * p * q * (p + q))
+        if fp == 0.0:
+            break
+        t -= f / fp
+    return [a2[i] * u[i] / (t + a2[i]) for i in range(3)]
+
+
+def ellipsoid_tangent_point(pe, r, p, a, vs, vs4):
+    """WrapEllipsoid::calcTangentPoint: move r (start: c1) to the point of the ellipse
+    (ellipsoid a, centre 0) cut by the plane vs.x + vs4 = 0 whose tangent passes through p.
+    OpenSim's damped least squares (4 unknowns r, d1; residuals: in plane, on ellipsoid, d1
+    definition, p in the tangent plane), then Newton steps to machine precision."""
+    if abs(pe) < 0.0001:
+        return list(p)
+    r = list(r)
+    m = [0.0, 0.0, 0.0]
+
+    def resid(r, d1):
+        nr = [2.0 * (r[i] - m[i]) / (a[i] * a[i]) for i in range(3)]
+        return [dot3(vs, r) + vs4,
+                -1.0 + sum(((r[i] - m[i]) / a[i]) ** 2 for i in range(3)),
+                dot3(nr, r) + d1, dot3(nr, p) + d1]
+
+    def jac(r):
+        # dedth[i][j] = d ee_j / d theta_i, theta = (r, d1)
+        d = [[vs[i], 2.0 * (r[i] - m[i]) / a[i] ** 2, 2.0 * (2.0 * r[i] - m[i]) / a[i] ** 2,
+              2.0 * p[i] / a[i] ** 2] for i in range(3)]
+        d.append([0.0, 0.0, 1.0, 1.0])
+        return d
+
+    nr = [2.0 * (r[i] - m[i]) / (a[i] * a[i]) for i in range(3)]
+    d1 = -dot3(nr, r)
+    ee = resid(r, d1)
+    ssqo = ssq = sum(e * e for e in ee)
+    alpha = 0.01
+    nit = 0
+    while ssq > 1e-8 and nit < 50:
+        nit += 1
+        dedth = jac(r)
+        p1r1 = unit_or_zero(vec_sub(p, r))
+        p1m = unit_or_zero(vec_sub(p, m))
+        pcos = dot3(p1r1, p1m)
+        dd = 1.0 - pcos ** 100 if pcos > 0.1 else 1.0
+        v = [-sum(dedth[i][j] * ee[j] for j in range(4)) for i in range(4)]
+        d2 = [[sum(dedth[i][k] * dedth[j][k] for k in range(4)) for j in range(4)]
+              for i in range(4)]
+        diag = [d2[i][i] for i in range(4)]
+        vt = [0.0] * 4
+        nit2 = 0
+        while ssq >= ssqo and nit2 < 1000:
+            for i in range(4):
+                d2[i][i] = diag[i] * (1.0 + alpha)
+            step = solve_linear(d2, v)
+            vt = [dd * s / 16.0 for s in step]
+            r = [r[i] + vt[i] for i in range(3)]
+            d1 += vt[3]
+            ee = resid(r, d1)
+            ssqo = ssq
+            ssq = sum(e * e for e in ee)
+            alpha *= 4.0
+            nit2 += 1
+        alpha /= 8.0
+        fakt = 0.5
+        nit2 = 0
+        while ssq <= ssqo and nit2 < 1000:
+            fakt *= 2.0
+            r = [r[i] + vt[i] * fakt for i in range(3)]
+            d1 += vt[3] * fakt
+            ee = resid(r, d1)
+            ssqo = ssq
+            ssq = sum(e * e for e in ee)
+            nit2 += 1
+        r = [r[i] - vt[i] * fakt for i in range(3)]
+        d1 -= vt[3] * fakt
+        ee = resid(r, d1)
+        ssq = ssqo = sum(e * e for e in ee)
+    # polish (not in OpenSim): Newton on the same 4 equations
+    for _ in range(30):
+        dedth = jac(r)
+        j = [[dedth[i][k] for i in range(4)] for k in range(4)]
+        try:
+            step = solve_linear(j, [-e for e in ee])
+        except ZeroDivisionError:
+            break
+        r = [r[i] + step[i] for i in range(3)]
+        d1 += step[3]
+        ee = resid(r, d1)
+        if max(abs(s) for s in step) < 1e-15:
+            break
+    return r
+
+
+def ellipsoid_arc(r1, r2, a, vs, vs4, far_side):
+    """WrapEllipsoid::CalcDistanceOnEllipsoid: the curve where the wrapping plane cuts the
+    ellipsoid, from r1 to r2 (the short way, or the long way if far_side), sampled at equal
+    angles about the point a0 where the plane meets the axis most normal to it. Returns (points
+    r1 .. r2, polyline length) in normalised units; WRAP_ARC_SEGMENTS chords."""
+    n = WRAP_ARC_SEGMENTS
+    imax = 0
+    for i in (1, 2):
+        if abs(vs[i]) > abs(vs[imax]):
+            imax = i
+    u = [0.0, 0.0, 0.0]
+    u[imax] = 1.0
+    mu = -vs4 / dot3(vs, u)
+    a0 = vec_scale(u, mu)
+    ar1 = unit_or_zero(vec_sub(r1, a0))
+    ar2 = unit_or_zero(vec_sub(r2, a0))
+    phi0 = math.acos(max(-1.0, min(1.0, dot3(ar1, ar2))))
+    dphi = -(2.0 * math.pi - phi0) / n if far_side else phi0 / n
+    vsz = unit_or_zero(cross3(ar1, ar2))
+    vsy = cross3(vsz, ar1)
+    pts = [list(r1)]
+    f2 = [a0[i] / a[i] for i in range(3)]
+    cc = dot3(f2, f2) - 1.0
+    for i in range(n - 1):
+        phi = (i + 1) * dphi
+        r = [math.cos(phi) * ar1[k] + math.sin(phi) * vsy[k] for k in range(3)]
+        f1 = [r[k] / a[k] for k in range(3)]
+        aa, bb = dot3(f1, f1), 2.0 * dot3(f1, f2)
+        mu3 = (-bb + math.sqrt(max(0.0, bb * bb - 4.0 * aa * cc))) / (2.0 * aa)
+        pts.append([a0[k] + mu3 * r[k] for k in range(3)])
+    pts.append(list(r2))
+    length = sum(vec_norm(vec_sub(pts[i + 1], pts[i])) for i in range(n))
+    return pts, length
+
+
+def ellipsoid_wrap_line(dims, quadrant, method, pt1, pt2):
+    """WrapEllipsoid::wrapLine for the segment pt1-pt2 (wrap-object frame). Returns
+    (WrapAction, r1, r2, wrap length) with r1, r2 in the wrap-object frame."""
+    factor = 3.0 / sum(dims)
+    p1 = vec_scale(pt1, factor)
+    p2 = vec_scale(pt2, factor)
+    a = vec_scale(dims, factor)
+    m = [0.0, 0.0, 0.0]
+    p1e = -1.0 + sum((p1[i] / a[i]) ** 2 for i in range(3))
+    p2e = -1.0 + sum((p2[i] / a[i]) ** 2 for i in range(3))
+    if p1e < -0.0001 or p2e < -0.0001:
+        return WRAP_INSIDE, None, None, 0.0
+    p1p2 = vec_sub(p1, p2)
+    ppm = dot3(unit_or_zero(p1), unit_or_zero(p2)) - 1.0
+    if abs(ppm) < 0.0001:
+        return WRAP_NO, None, None, 0.0
+    f1 = [p1p2[i] / a[i] for i in range(3)]
+    f2 = [p2[i] / a[i] for i in range(3)]
+    aa, bb, cc = dot3(f1, f1), 2.0 * dot3(f1, f2), dot3(f2, f2) - 1.0
+    disc = bb * bb - 4.0 * aa * cc
+    if disc < 0.0:
+        return WRAP_NO, None, None, 0.0
+    l1 = (-bb + math.sqrt(disc)) / (2.0 * aa)
+    l2 = (-bb - math.sqrt(disc)) / (2.0 * aa)
+    if not (0.0 < l1 < 1.0) or not (0.0 < l2 < 1.0):
+        return WRAP_NO, None, None, 0.0
+    r1 = vec_add(p2, vec_scale(p1p2, l1))
+    r2 = vec_add(p2, vec_scale(p1p2, l2))
+    r1r2 = vec_sub(r2, r1)
+    # wrapping plane: Frans technique (most parallel axis) and/or fan (WrapEllipsoid.cpp)
+    mu = [abs(x) for x in unit_or_zero(p1p2)]
+    t, t_sv, t_c1 = [0.0] * 3, [None] * 3, [None] * 3
+    for i in range(3):
+        t[i] = (m[i] - r1[i]) / r1r2[i] if r1r2[i] != 0.0 else float("inf")
+        t_sv[i] = [r1[j] + t[i] * r1r2[j] for j in range(3)] if r1r2[i] != 0.0 else list(r1)
+        t_c1[i] = ellipsoid_closest_point(a, t_sv[i], i)
+    best = 0
+    for i in (1, 2):
+        if mu[i] > mu[best]:
+            best = i
+    fan_weight = -float("inf")
+    c1 = sv = None
+    if method in ("hybrid", "axial"):
+        if method == "hybrid" and mu[best] > ELL_MU_BLEND_MIN:
+            s = 1.0
+            if t[best] < 0.0 or t[best] > 1.0:
+                s = 0.0
+            elif t[best] < ELL_SV_BOUNDARY_BLEND:
+                s = t[best] / ELL_SV_BOUNDARY_BLEND
+            elif t[best] > 1.0 - ELL_SV_BOUNDARY_BLEND:
+                s = (1.0 - t[best]) / ELL_SV_BOUNDARY_BLEND
+            if s < 1.0:
+                mu[best] = ELL_MU_BLEND_MIN + s * (mu[best] - ELL_MU_BLEND_MIN)
+        if method == "axial" or mu[best] > ELL_MU_BLEND_MIN:
+            c1, sv = list(t_c1[best]), list(t_sv[best])
+        if method == "hybrid" and mu[best] < ELL_MU_BLEND_MAX:
+            v_sum = [0.0, 0.0, 0.0]
+            mid = [r1[i] + 0.5 * r1r2[i] for i in range(3)]
+            for i in range(1, ELL_FAN_SAMPLES - 1):
+                tt = float(i) / ELL_FAN_SAMPLES
+                s0 = [r1[j] + tt * r1r2[j] for j in range(3)]
+                c0 = ellipsoid_closest_point(a, s0)
+                v_sum = vec_add(v_sum, unit_or_zero(vec_sub(c0, s0)))
+            v_sum = unit_or_zero(v_sum)
+            tc = vec_add(mid, v_sum)
+            if mu[best] <= ELL_MU_BLEND_MIN:
+                c1 = ellipsoid_closest_point(a, tc)
+                sv = mid
+                fan_weight = 1.0
+            else:
+                tt = (mu[best] - ELL_MU_BLEND_MIN) / (ELL_MU_BLEND_MAX - ELL_MU_BLEND_MIN)
+                cf = ellipsoid_closest_point(a, tc)
+                blend = [tt * c1[i] + (1.0 - tt) * cf[i] for i in range(3)]
+                sv = [tt * sv[i] + (1.0 - tt) * mid[i] for i in range(3)]
+                c1 = ellipsoid_closest_point(a, blend)
+                fan_weight = 1.0 - tt
+    elif method == "midpoint":
+        sv = [r1[i] + 0.5 * (r2[i] - r1[i]) for i in range(3)]
+        c1 = ellipsoid_closest_point(a, sv)
+    else:
+        raise ValueError("PathWrap method %s not implemented" % method)
+    if method != "axial" or 0.0 < t[best] < 1.0:
+        r1, r2 = list(c1), list(c1)
+    axis, sign = quadrant
+    if sign != 0 and dsign(c1[axis] - m[axis]) != sign:
+        orig = list(c1)
+        c1[axis] = -c1[axis]
+        r1, r2 = list(c1), list(c1)
+        if fan_weight == -float("inf"):
+            fan_weight = 1.0 - (mu[best] - ELL_MU_BLEND_MIN) / (ELL_MU_BLEND_MAX - ELL_MU_BLEND_MIN)
+        fan_weight = min(fan_weight, 1.0)
+        if fan_weight > 0.0:
+            bis = 0.5 * (orig[axis] + c1[axis])
+            c1[axis] = c1[axis] + fan_weight * (bis - c1[axis])
+            c1 = ellipsoid_closest_point(a, c1)
+    vs = unit_or_zero(cross3(p1p2, vec_sub(p1, c1)))
+    vs4 = -dot3(vs, c1)
+    r1 = ellipsoid_tangent_point(p1e, r1, p1, a, vs, vs4)
+    r2 = ellipsoid_tangent_point(p2e, r2, p2, a, vs, vs4)
+    far_side = False
+    while True:
+        pts, length = ellipsoid_arc(r1, r2, a, vs, vs4, far_side)
+        if sign != 0 and len(pts) > 2 and not far_side:
+            r1p1 = unit_or_zero(vec_sub(p1, r1))
+            r1w1 = unit_or_zero(vec_sub(pts[1], r1))
+            r2p2 = unit_or_zero(vec_sub(p2, r2))
+            r2w2 = unit_or_zero(vec_sub(pts[-2], r2))
+            if dot3(r1p1, r1w1) > 0.0 or dot3(r2p2, r2w2) > 0.0:
+                far_side = True
+                continue
+        break
+    return (WRAP_MANDATORY, vec_scale(r1, 1.0 / factor), vec_scale(r2, 1.0 / factor),
+            length / factor)
+
+
+def closest_on_axis(p):
+    """Closest point to p on the cylinder axis (local z) and the distance to it."""
+    return [0.0, 0.0, p[2]], math.hypot(p[0], p[1])
+
+
+def intersect_lines(p1, p2, p3, p4):
+    """WrapMath::IntersectLines: closest points of lines p1p2 and p3p4 and their parameters
+    (fractions of p1p2 and p3p4); None if parallel."""
+    v1, v2 = vec_sub(p2, p1), vec_sub(p4, p3)
+    mag1, mag2 = vec_norm(v1), vec_norm(v2)
+    v1, v2 = vec_scale(v1, 1.0 / mag1), vec_scale(v2, 1.0 / mag2)
+    cp = cross3(v1, v2)
+    denom = dot3(cp, cp)
+    if abs(denom) <= ROUNDOFF_ERROR:
+        return None
+
+    def det(r0, r1, r2):
+        return (r0[0] * (r1[1] * r2[2] - r1[2] * r2[1]) - r0[1] * (r1[0] * r2[2] - r1[2] * r2[0])
+                + r0[2] * (r1[0] * r2[1] - r1[1] * r2[0]))
+    d31 = vec_sub(p3, p1)
+    t = det(d31, v1, cp) / denom
+    s = det(d31, v2, cp) / denom
+    return vec_add(p1, vec_scale(v1, s)), s / mag1, vec_add(p3, vec_scale(v2, t)), t / mag2
+
+
+def cylinder_wrap_line(radius, length, quadrant, pt1, pt2):
+    """WrapCylinder::wrapLine for the segment pt1-pt2 (wrap-object frame, axis z). OpenSim's
+    decisions (inside, miss, mandatory/wrapped, active side, tangent-point candidates, long
+    wrap, display length) are ported; the spiral is the exact geodesic: developed into the
+    plane, P1 - r1 - spiral - r2 - P2 is one straight line, so with d1, d2 the tangent lengths
+    in the cross-section and theta the angle between the chosen tangent points the path is
+    sqrt((d1 + R theta + d2)^2 + dz^2) (the limit of OpenSim's _adjust_tangent_point loop).
+    Returns (WrapAction, r1, r2, wrap length)."""
+    dn = [0.0, 0.0, 1.0]
+    r2sq = radius * radius
+    axis, sign = quadrant
+    constrained = sign != 0
+    p11, rho1 = closest_on_axis(pt1)
+    p22, rho2 = closest_on_axis(pt2)
+    if rho1 * rho1 < r2sq or rho2 * rho2 < r2sq:
+        return WRAP_INSIDE, None, None, 0.0
+    hit = intersect_lines(pt1, pt2, [0.0, 0.0, -0.5 * length], [0.0, 0.0, 0.5 * length])
+    if hit is None:
+        return WRAP_NO, None, None, 0.0
+    near12, t12, near00, _ = hit
+    d_sq = sum((near12[i] - near00[i]) ** 2 for i in range(3))
+    code = WRAP_WRAPPED
+    if not constrained:
+        if d_sq < r2sq and 0.0 < t12 < 1.0:
+            code = WRAP_MANDATORY
+        else:
+            return WRAP_NO, None, None, 0.0
+
+    def candidates(p, pax, rho):
+        vv = vec_scale(vec_sub(p, pax), 1.0 / rho)
+        dist = radius * radius / rho
+        pp = vec_add(pax, vec_scale(vv, dist))
+        dist = math.sqrt(r2sq - dist * dist)
+        uu = cross3(dn, vv)
+        return vec_add(pp, vec_scale(uu, dist)), vec_sub(pp, vec_scale(uu, dist))
+    r1a, r1b = candidates(pt1, p11, rho1)
+    r2a, r2b = candidates(pt2, p22, rho2)
+    far_side = long_wrap = False
+    if constrained:
+        if dsign(pt1[axis]) == sign or dsign(pt2[axis]) == sign:
+            if d_sq < r2sq and 0.0 < t12 < 1.0:
+                code = WRAP_MANDATORY
+            elif dsign(pt1[axis]) != dsign(pt2[axis]) and dsign(near12[axis]) != sign:
+                code = WRAP_WRAPPED
+            else:
+                return WRAP_NO, None, None, 0.0
+        r1am, r1bm = vec_sub(r1a, p11), vec_sub(r1b, p11)
+        r2am, r2bm = vec_sub(r2a, p22), vec_sub(r2b, p22)
+
+        def ang(u, v):
+            return math.acos(max(-1.0, min(1.0, dot3(u, v) / (vec_norm(u) * vec_norm(v)))))
+        alpha, beta = ang(r1am, r2bm), ang(r1bm, r2am)
+        on = [dsign(r[axis]) == sign for r in (r1a, r1b, r2a, r2b)]
+        if on[0] and on[1]:
+            if on[2]:
+                r1, r2, far_side = r1b, r2a, not alpha > beta
+            else:
+                r1, r2, far_side = r1a, r2b, alpha > beta
+        elif on[0] and not on[1]:
+            r1, r2, far_side = r1a, r2b, alpha > beta
+        elif not on[0] and on[1]:
+            r1, r2, far_side = r1b, r2a, not alpha > beta
+        else:
+            if on[2]:
+                r1, r2, far_side = r1b, r2a, not alpha > beta
+            elif on[3]:
+                r1, r2, far_side = r1a, r2b, alpha > beta
+            elif alpha > beta:
+                r1, r2, far_side = r1a, r2b, True
+            else:
+                r1, r2, far_side = r1b, r2a, True
+        sum_musc = [(r1[i] - pt1[i]) + (r2[i] - pt2[i]) for i in range(3)]
+        sum_r = [(r1[i] - p11[i]) + (r2[i] - p22[i]) for i in range(3)]
+        long_wrap = dot3(sum_r, sum_musc) < 0.0
+    else:
+        n1a = unit_or_zero(vec_sub(r1a, p11))
+        n1b = unit_or_zero(vec_sub(r1b, p11))
+        n2a = unit_or_zero(vec_sub(r2a, p22))
+        n2b = unit_or_zero(vec_sub(r2b, p22))
+        d1, d2, d3, d4 = dot3(n1a, n2a), dot3(n1a, n2b), dot3(n1b, n2a), dot3(n1b, n2b)
+        if d1 > d2 and d1 > d3 and d1 > d4:
+            r1, r2 = r1a, r2a
+        elif d2 > d3 and d2 > d4:
+            r1, r2 = r1a, r2b
+        elif d3 > d4:
+            r1, r2 = r1b, r2a
+        else:
+            r1, r2 = r1b, r2b
+    # OpenSim's preliminary axial placement (apex plane), used only for the display-length rule
+    uu = vec_sub(r1, p11)
+    vv = unit_or_zero(vec_add(uu, vec_sub(r2, p22)))
+    tt = rho1 / (rho1 + rho2)
+    mpt = vec_add(pt1, vec_scale(vec_sub(pt2, pt1), tt))
+    axispt = [0.0, 0.0, mpt[2]]
+    l1 = unit_or_zero(vec_sub(pt1, axispt))
+    l2 = unit_or_zero(vec_sub(pt2, axispt))
+    normal = unit_or_zero(cross3(l1, l2))
+    vert1 = unit_or_zero(cross3(dn, normal))
+    vert2 = unit_or_zero(cross3(normal, dn))
+    apex1 = vec_add(axispt, vec_scale(vert1, radius))
+    apex2 = vec_add(axispt, vec_scale(vert2, radius))
+    dist1 = sum((mpt[i] - apex1[i]) ** 2 for i in range(3))
+    dist2 = sum((mpt[i] - apex2[i]) ** 2 for i in range(3))
+    if far_side:
+        apex = apex2 if dist1 < dist2 else apex1
+    else:
+        apex = apex1 if dist1 < dist2 else apex2
+    normal = cross3(unit_or_zero(vec_sub(pt1, apex)), unit_or_zero(vec_sub(pt2, apex)))
+    normal = unit_or_zero(normal)
+    dpl = -dot3(pt1, normal)
+    pre = []
+    for r, pax_far, pax_near in ((r1, p22, p11), (r2, p11, p22)):
+        lo, hi = vec_sub(r, vec_scale(dn, 10.0)), vec_add(r, vec_scale(dn, 10.0))
+        vec = vec_sub(hi, lo)
+        dp = dot3(vec, normal)
+        z = r[2]
+        if abs(dp) >= 1e-5:
+            tp = (-dpl - dot3(normal, lo)) / dp
+            if -1e-5 <= tp <= 1.0 + 1e-5:
+                rp = vec_add(lo, vec_scale(vec, tp))
+                # keep the plane point if it projects between p11 and p22 (OpenSim's test)
+                seg = vec_sub(pax_far, pax_near)
+                seg_len2 = dot3(seg, seg)
+                if seg_len2 > 0.0:
+                    s = dot3(vec_sub(rp, pax_near), seg) / seg_len2
+                    proj = vec_add(pax_near, vec_scale(seg, s))
+                    if (sum((proj[i] - pax_far[i]) ** 2 for i in range(3))
+                            < seg_len2):
+                        z = rp[2]
+        pre.append(z)
+    half = 0.5 * length
+    if (pre[0] < -half or pre[0] > half) and (pre[1] < -half or pre[1] > half):
+        return WRAP_NO, None, None, 0.0
+    # exact geodesic with the chosen tangent points and sense
+    theta = math.acos(max(-1.0, min(1.0, dot3(unit_or_zero([r1[0], r1[1], 0.0]),
+                                                unit_or_zero([r2[0], r2[1], 0.0])))))
+    if long_wrap:
+        theta = 2.0 * math.pi - theta
+    d1 = math.sqrt(max(0.0, rho1 * rho1 - r2sq))
+    d2 = math.sqrt(max(0.0, rho2 * rho2 - r2sq))
+    s_total = d1 + radius * theta + d2
+    dz = pt2[2] - pt1[2]
+    z1 = pt1[2] + dz * d1 / s_total
+    z2 = pt1[2] + dz * (d1 + radius * theta) / s_total
+    wrap_len = math.hypot(radius * theta, z2 - z1)
+    return code, [r1[0], r1[1], z1], [r2[0], r2[1], z2], wrap_len
+
+
+def wrap_line(w, method, pt1, pt2):
+    if w["type"] == "WrapEllipsoid":
+        return ellipsoid_wrap_line(w["dimensions"], wrap_quadrant(w), method, pt1, pt2)
+    if w["type"] == "WrapCylinder":
+        return cylinder_wrap_line(w["radius"], w["length"], wrap_quadrant(w), pt1, pt2)
+    raise ValueError("wrap object type %s is not implemented in the reference" % w["type"])
+
+
+def read_wrap_methods(osim_path):
+    """{muscle name: [PathWrap method, in PathWrapSet order]} (hybrid, midpoint, axial; OpenSim's
+    default hybrid), read from the .osim (not needed by the MJCF conversion)."""
+    root = ET.parse(osim_path).getroot()
+    out = {}
+    for f in root.find("Model").find("ForceSet/objects"):
+        out[f.get("name")] = [(w.findtext("method") or "hybrid").strip()
+                              for w in f.findall("GeometryPath/PathWrapSet/objects/PathWrap")]
+    return out
+
+
+def wrapped_path(model, muscle, independent, methods):
+    """OpenSim's wrapped path of a muscle at a pose (GeometryPath::applyWrapObjects with the
+    wrap objects above). Returns (length, [names of the wrap objects the path touches])."""
+    values, x = model.pose_state(independent)
+    objects = {}
+    for b in model.body_order:
+        for w in model.bodies[b]["wraps"]:
+            objects[w["name"]] = (b, w)
+    allpts = muscle["points"]
+    active = [point_is_active(p, values) for p in allpts]
+    # path nodes: [kind, wrap index or point index, body, location, wrap length]
+    path = [["pt", i, p["body"], point_location(p, values), 0.0]
+            for i, p in enumerate(allpts) if active[i]]
+    pws = muscle["wraps"]
+    if not pws:
+        return path_length(model, muscle, independent), []
+
+    def ground(node):
+        return tf_point(x[node[2]], node[3])
+
+    def same_wrap(n1, n2):
+        return n1[0] != "pt" and n2[0] != "pt" and n1[1] == n2[1]
+
+    def total(path):
+        length = 0.0
+        for i in range(len(path) - 1):
+            if same_wrap(path[i], path[i + 1]):
+                length += path[i + 1][4]
+            else:
+                length += vec_norm(vec_sub(ground(path[i + 1]), ground(path[i])))
+        return length
+
+    methods = methods[muscle["name"]]
+    order = list(range(len(pws)))
+    result = [WRAP_NO] * len(pws)
+    max_iter = 1 if len(pws) < 2 else WRAP_ITER_MAX
+    last = float("inf")
+    for kk in range(max_iter):
+        for i in range(len(pws)):
+            k = order[i]
+            pw = pws[k]
+            body, w = objects[pw["object"]]
+            frame = tf_mul(x[body], (w["rotation"], w["translation"]))
+            inv = tf_inv(frame)
+            path = [n for n in path if not (n[0] != "pt" and n[1] == k)]
+            result[i] = WRAP_NO
+            lo, hi = pw["range"]
+            start = 0 if lo < 1 else lo - 1
+            end = len(allpts) - 1 if hi < 1 else hi - 1
+            jf = start
+            while jf <= end and not active[jf]:
+                jf += 1
+            jr = end
+            while jr >= start and not active[jr]:
+                jr -= 1
+            if jf > end or jr < start:
+                continue
+            s_idx = [n for n, node in enumerate(path) if node[0] == "pt" and node[1] == jf][0]
+            e_idx = [n for n, node in enumerate(path) if node[0] == "pt" and node[1] == jr][0]
+            best, min_change = None, float("inf")
+            for p1 in range(s_idx, e_idx):
+                n1, n2 = path[p1], path[p1 + 1]
+                if same_wrap(n1, n2):
+                    continue
+                g1, g2 = ground(n1), ground(n2)
+                code, r1, r2, wlen = wrap_line(w, methods[k], tf_point(inv, g1),
+                                               tf_point(inv, g2))
+                result[i] = code
+                if code == WRAP_MANDATORY:
+                    best = (p1, r1, r2, wlen)
+                    break
+                if code == WRAP_WRAPPED:
+                    change = (vec_norm(vec_sub(tf_point(frame, r1), g1)) + wlen
+                              + vec_norm(vec_sub(tf_point(frame, r2), g2))
+                              - vec_norm(vec_sub(g2, g1)))
+                    if change < min_change:
+                        best, min_change = (p1, r1, r2, wlen), change
+            if best is not None:
+                p1, r1, r2, wlen = best
+                wb = (w["rotation"], w["translation"])
+                path.insert(p1 + 1, ["w1", k, body, tf_point(wb, r1), 0.0])
+                path.insert(p1 + 2, ["w2", k, body, tf_point(wb, r2), wlen])
+        length = total(path)
+        if abs(length - last) < WRAP_ITER_TOL:
+            break
+        last = length
+        if kk == 0 and len(pws) > 1 and result[0] == WRAP_NO and result[1] == WRAP_INSIDE:
+            order[0], order[1] = 1, 0
+            path = [n for n in path if not (n[0] != "pt" and n[1] == 0)]
+    touched = sorted(set(pws[n[1]]["object"] for n in path if n[0] != "pt"))
+    return total(path), touched
+
+
+def wrapped_moment_arms(model, muscle, pose, coordinates, methods):
+    """r = -dL/dq of the wrapped path by central differences (h = FD_STEP)."""
+    out = {}
+    for c in coordinates:
+        lo, hi = dict(pose), dict(pose)
+        lo[c] -= FD_STEP
+        hi[c] += FD_STEP
+        out[c] = -(wrapped_path(model, muscle, hi, methods)[0]
+                   - wrapped_path(model, muscle, lo, methods)[0]) / (2 * FD_STEP)
     return out
 
 
@@ -1431,7 +2118,12 @@ class Converter:
         write_atomic(path, "\n".join(out) + "\n")
 
 
-def write_reference(model, frames, path, poses_path, osim_name, trial_name):
+def write_reference(model, frames, path, poses_path, osim_name, trial_name, methods):
+    """The moment-arm reference (mjmodels/README.md, "Moment-arm comparison"): per pose, muscle
+    and crossed coordinate the straight-line value (value, as before), and OpenSim's wrapped
+    value (value_wrap: wrapped_path, for muscles without wrap objects the same path), both by
+    central differences; wrapping = 1 where OpenSim's path touches a wrap object at the pose.
+    methods: read_wrap_methods of the .osim."""
     idx = reference_poses(frames)
     lines = []
     lines.append("# GENERATED by %s (do not edit): muscle-tendon lengths and moment arms of %s"
@@ -1439,17 +2131,20 @@ def write_reference(model, frames, path, poses_path, osim_name, trial_name):
     lines.append("# (gilserrancoli/ReducePoly_forMSK, MIT; Knee Grand Challenge subject JW, "
                  "Fregly et al. 2012 J Orthop Res 30:503) computed from the OpenSim geometry only:")
     lines.append("# CustomJoint kinematics incl. reversed joints and coupler constraints, path points "
-                 "incl. conditional and moving points evaluated exactly, straight segments, NO wrapping.")
-    lines.append("# Poses: frames of %s listed in jw_poses.csv. value: length (m) or moment arm "
-                 "r = -dL/dq (m) by central differences, h = %g." % (trial_name, FD_STEP))
+                 "incl. conditional and moving points evaluated exactly.")
+    lines.append("# value: straight segments, NO wrapping. value_wrap: with OpenSim's wrapping "
+                 "(port of GeometryPath::applyWrapObjects, WrapEllipsoid, WrapCylinder;")
+    lines.append("# see wrapped_path in the converter and mjmodels/README.md). Poses: frames of %s "
+                 "listed in jw_poses.csv." % trial_name)
+    lines.append("# Length (m) or moment arm r = -dL/dq (m or m/m) by central differences, h = %g."
+                 % FD_STEP)
     lines.append("# wraps = 1 if the OpenSim path has wrap objects. clear = 1 if at this pose the straight path "
                  "misses every wrap object of the muscle")
-    lines.append("# (normalised clearance >= 1, see wrap_clearance; constrained quadrants respected), so "
-                 "OpenSim does not wrap and the")
-    lines.append("# reference is OpenSim's path; clear = 0: the straight path penetrates a wrap object and "
-                 "the reference is NOT OpenSim's path.")
+    lines.append("# (normalised clearance >= 1, see wrap_clearance; constrained quadrants respected). "
+                 "wrapping = 1 if OpenSim's wrapped path touches")
+    lines.append("# a wrap object at this pose (then value_wrap differs from value).")
     lines.append("# MuJoCo actuator_moment = dL/dq = -r.")
-    lines.append("pose,muscle,coordinate,value,wraps,clear")
+    lines.append("pose,muscle,coordinate,value,wraps,clear,value_wrap,wrapping")
     pose_lines = ["# GENERATED by %s: reference poses for jw_moment_arms.csv, frames of %s; "
                   "radians and m, model coordinate order" % (CONVERTER, trial_name),
                   "# pose: trial row (0-based), time (s): " + "; ".join(
@@ -1462,12 +2157,16 @@ def write_reference(model, frames, path, poses_path, osim_name, trial_name):
             wraps = 1 if mus["wraps"] else 0
             clearance = wrap_clearance(model, mus, pose)
             clear = 1 if clearance is None or clearance >= 1.0 else 0
-            lines.append("%d,%s,length,%s,%d,%d" % (k, mus["name"],
-                                                   fmt(path_length(model, mus, pose), 10), wraps,
-                                                   clear))
+            length_wrap, touched = wrapped_path(model, mus, pose, methods)
+            wrapping = 1 if touched else 0
+            lines.append("%d,%s,length,%s,%d,%d,%s,%d" % (
+                k, mus["name"], fmt(path_length(model, mus, pose), 10), wraps, clear,
+                fmt(length_wrap, 10), wrapping))
             crossed = crossed_coordinates(model, mus)
+            arms_wrap = wrapped_moment_arms(model, mus, pose, crossed, methods)
             for c, r in moment_arms(model, mus, pose, crossed).items():
-                lines.append("%d,%s,%s,%s,%d,%d" % (k, mus["name"], c, fmt(r, 8), wraps, clear))
+                lines.append("%d,%s,%s,%s,%d,%d,%s,%d" % (k, mus["name"], c, fmt(r, 8), wraps,
+                                                         clear, fmt(arms_wrap[c], 8), wrapping))
     write_atomic(path, "\n".join(lines) + "\n")
     write_atomic(poses_path, "\n".join(pose_lines) + "\n")
 
@@ -1528,7 +2227,8 @@ def main():
         add_knee_params(args.out, args.knee_params)
     write_reference(model, frames, args.reference_out,
                     os.path.join(os.path.dirname(args.reference_out), "jw_poses.csv"),
-                    os.path.basename(args.osim), os.path.basename(trial))
+                    os.path.basename(args.osim), os.path.basename(trial),
+                    read_wrap_methods(args.osim))
     print("wrote %s (%d dof, %d muscles, %.4f kg) and %s" % (
         args.out, len(MODEL_COORDINATES), len(model.muscles),
         sum(b["mass"] for b in model.bodies.values()), args.reference_out))

@@ -46,6 +46,12 @@ static const char* kTrackUsage =
     "  --max-iter N        Ipopt iteration limit (default 1000)\n"
     "  --max-time S        wall-clock limit, s (default none)\n"
     "  --activation A      initial activations and excitations (default 0.05)\n"
+    "  --guess-method M    initial guess from the trial (without --init): trial (default:\n"
+    "                      measured coordinates, activations A) or static (static optimisation\n"
+    "                      at every node: min sum a^2 with the muscles' force-length-velocity\n"
+    "                      forces matching the inverse-dynamics moments of every dof but the\n"
+    "                      pelvis and the spring-held knee dofs, measured GRF at the measured\n"
+    "                      centres of pressure; tendon forces from the muscle forces)\n"
     "  --hessian H         lbfgs (default: Ipopt's limited-memory quasi-Newton), pqn\n"
     "                      (partitioned quasi-Newton, SR1 per node element; experimental),\n"
     "                      gauss-newton (exact for the tracking squares, constraints left out)\n"
@@ -71,6 +77,7 @@ typedef struct {
   int max_iter;        // iteration limit
   double max_time;     // wall limit (s), <= 0: none
   double activation;   // initial activation (-)
+  int guess_static;    // 1: static-optimisation guess (go_gait_guess_static), 0: the trial's
   go_ipopt_opts ipopt; // solver options
   double w_pelvis_rot, w_pelvis_trans, w_joint, w_grf, w_effort;  // goal weights (-)
   double w_accel;      // weight of the mean squared acceleration (qddot / 50)^2 (-)
@@ -148,12 +155,13 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
       {"activation", required_argument, NULL, 'a'}, {"ipopt", required_argument, NULL, 'p'},
       {"hessian", required_argument, NULL, 'H'},  {"weight", required_argument, NULL, 'w'},
       {"init", required_argument, NULL, 'I'},     {"no-polish", no_argument, NULL, 'P'},
+      {"guess-method", required_argument, NULL, 'G'},
       {"help", no_argument, NULL, 'h'},           {NULL, 0, NULL, 0}};
   defaults(o);
   optind = 1;
   int c;
   char *end;
-  while ((c = getopt_long(argc, argv, "o:m:n:t:i:T:a:p:H:w:I:Ph", options, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, "o:m:n:t:i:T:a:p:H:w:I:G:Ph", options, NULL)) != -1) {
     switch (c) {
       case 'o': o->out = optarg; break;
       case 'm': o->model = optarg; break;
@@ -191,12 +199,16 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
         if (parse_weight(optarg, o)) return -1;
         break;
       case 'I': o->init = optarg; break;
+      case 'G':
+        o->guess_static = strcmp(optarg, "static") == 0;
+        if (!o->guess_static && strcmp(optarg, "trial") != 0) return -1;
+        break;
       case 'P': o->polish = 0; break;
       case 'h': fputs(kTrackUsage, stdout); exit(GS_EXIT_OK);
       default: return -1;
     }
   }
-  if (optind != argc - 1 || !o->out) return -1;
+  if (optind != argc - 1 || !o->out || (o->guess_static && o->init)) return -1;
   o->trial = argv[optind];
   return 0;
 }
@@ -963,6 +975,16 @@ static int solve(gsTrackOptions o) {
     int from_vars = guess_from_variables(g, o.init, z);
     if (from_vars < 0 || (from_vars == 0 && guess_from_folder(g, m, o.init, o.activation, z) != 0))
       goto done;
+  } else if (o.guess_static) {
+    go_static_report sr;
+    if (go_gait_guess_static(g, &coords, &grf, z, &sr, err, sizeof(err)) != 0) {
+      fprintf(stderr, "gaitsim: track: %s\n", err);
+      goto done;
+    }
+    fprintf(stderr, "track: static-optimisation guess: %d matched dofs, residual rms %.3g max "
+            "%.3g (N m), mean activation %.3f, %d node-muscle pairs at a = 1, %d QP steps, %d "
+            "nodes at the step limit\n", sr.n_matched, sr.rms_residual, sr.max_residual,
+            sr.mean_activation, sr.n_at_upper, sr.steps, sr.failed_nodes);
   } else if (go_gait_guess_from_trial(g, &coords, o.activation, z, err, sizeof(err)) != 0) {
     fprintf(stderr, "gaitsim: track: %s\n", err);
     goto done;

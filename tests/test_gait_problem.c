@@ -20,9 +20,8 @@
 #include "optim/go_hessian.h"
 #include "optim/go_jacobian.h"
 #include "tests/gs_test.h"
+#include "tests/gs_test_trial.h"
 #include "tests/gs_test_nlp.h"
-
-#define TRIAL GAITSIM_SOURCE_DIR "/mjmodels/trials/jw_ngait_og5"
 
 static double now(void) {
   struct timespec ts;
@@ -53,14 +52,10 @@ static go_gait* make(const mjModel* m, const gsTable* coords, const gsTable* grf
 }
 
 int main(void) {
-  mjModel* m = gs_app_load_model(GAITSIM_SOURCE_DIR "/mjmodels/jw_fullbody.xml");
   gsTable coords, grf;
-  gs_table_init(&coords);
-  gs_table_init(&grf);
+  mjModel* m = gs_test_load_trial(&coords, &grf);
   EXPECT_TRUE(m != NULL);
   if (!m) return GS_TEST_RESULT();
-  EXPECT_EQ_INT(0, gs_app_read_table(m, TRIAL "/coordinates.mot", &coords));
-  EXPECT_EQ_INT(0, gs_app_read_table(m, TRIAL "/grf.mot", &grf));
   go_gait* g0 = make(m, &coords, &grf, 1, 0);  // the tracking problem as it was
   go_gait* g1 = make(m, &coords, &grf, 1, 1);
   go_gait* g2 = make(m, &coords, &grf, 2, 1);

@@ -26,8 +26,7 @@
 #include "optim/go_hessian.h"
 #include "optim/go_jacobian.h"
 #include "tests/gs_test.h"
-
-#define TRIAL GAITSIM_SOURCE_DIR "/mjmodels/trials/jw_ngait_og5"
+#include "tests/gs_test_trial.h"
 
 // noise of the brute force: Jacobian entries up to 1e3 from central differences with step 6e-6
 // carry about 2e-8, divided by the brute-force step 2e-4
@@ -54,14 +53,10 @@ static void jt_lambda(int nele, const int* ir, const int* jc, const double* J, c
 }
 
 int main(void) {
-  mjModel* m = gs_app_load_model(GAITSIM_SOURCE_DIR "/mjmodels/jw_fullbody.xml");
   gsTable coords, grf;
-  gs_table_init(&coords);
-  gs_table_init(&grf);
+  mjModel* m = gs_test_load_trial(&coords, &grf);
   EXPECT_TRUE(m != NULL);
   if (!m) return GS_TEST_RESULT();
-  EXPECT_EQ_INT(0, gs_app_read_table(m, TRIAL "/coordinates.mot", &coords));
-  EXPECT_EQ_INT(0, gs_app_read_table(m, TRIAL "/grf.mot", &grf));
   go_gait* g1 = make(m, &coords, &grf, 1);
   go_gait* g2 = make(m, &coords, &grf, 2);
   EXPECT_TRUE(g1 && g2);

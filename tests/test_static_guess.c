@@ -24,8 +24,8 @@
 #include "optim/go_gait.h"
 #include "optim/go_gait_guess.h"
 #include "tests/gs_test.h"
+#include "tests/gs_test_trial.h"
 
-#define TRIAL GAITSIM_SOURCE_DIR "/mjmodels/trials/jw_ngait_og5"
 #define STATIC_TOL_NM 0.5  // N m (N on slides): linearisation of the elastic muscles, converged
 
 static void solver_cases(void) {
@@ -94,14 +94,10 @@ static double violation(go_gait* g, const double* z) {
 
 int main(void) {
   solver_cases();
-  mjModel* m = gs_app_load_model(GAITSIM_SOURCE_DIR "/mjmodels/jw_fullbody.xml");
   gsTable coords, grf;
-  gs_table_init(&coords);
-  gs_table_init(&grf);
+  mjModel* m = gs_test_load_trial(&coords, &grf);
   EXPECT_TRUE(m != NULL);
   if (!m) return GS_TEST_RESULT();
-  EXPECT_EQ_INT(0, gs_app_read_table(m, TRIAL "/coordinates.mot", &coords));
-  EXPECT_EQ_INT(0, gs_app_read_table(m, TRIAL "/grf.mot", &grf));
   const int N = 10;
   go_gait* g = make(m, &coords, &grf, N);
   EXPECT_TRUE(g != NULL);

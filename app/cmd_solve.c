@@ -250,10 +250,11 @@ static double normalise_grf_to_weight(gsTable* grf, double weight) {
 // -(k (q - q_spring) + b qdot) along the joint axis, which points from the femoral component to
 // the tibial tray (-y of the femoral component), so compression gives a positive force; medial
 // and lateral NAN. All NAN without a knee_ty joint.
-static void knee_contact(const mjModel* m, mjData* d, double f[3]) {
-  f[0] = f[1] = f[2] = NAN;
+static void knee_contact(const mjModel* m, mjData* d, double f[3], double* ligament) {
+  f[0] = f[1] = f[2] = *ligament = NAN;
   gsKneeLoads loads;
   if (gs_knee_passive(m, d, &loads) == 1) {
+    *ligament = loads.ligament_force;
     // what the eTibia's load cells measure (Fregly et al. 2012): the axial component, along the
     // tibial_tray y axis (the tray's long axis); the surrogate's force on the tibia points -y in
     // compression. Shear (the posterior slope, roll-back) is left out as in the measurement.
@@ -372,10 +373,12 @@ static int guess_from_variables(const go_gait* g, const char* dir, double* z) {
 }
 
 // knee_contact.sto columns (N): right (implant) knee medial, lateral, total (knee_contact), left
-// (1-DOF) knee compressive joint reaction along the tibia (gs_knee_reaction.h)
-#define GS_KNEE_COLUMNS 4
-static const char* const kKneeLabels[GS_KNEE_COLUMNS] = {"contact_medial_r", "contact_lateral_r",
-                                                         "contact_total_r", "contact_total_l"};
+// (1-DOF) knee compressive joint reaction along the tibia (gs_knee_reaction.h), and the right
+// knee's ligament tension, the sum over its bundles (surrogate knee only)
+#define GS_KNEE_COLUMNS 5
+static const char* const kKneeLabels[GS_KNEE_COLUMNS] = {
+    "contact_medial_r", "contact_lateral_r", "contact_total_r", "contact_total_l",
+    "ligament_total_r"};
 
 // knee_contact.sto: the columns that are finite at every node (none: no file)
 static int write_knee_table(const char* out, const gsTable* knee) {
@@ -444,7 +447,7 @@ static int write_solution(go_gait* g, const double* z, const char* out, const do
     gs_grf_table_set_row(m, d, t, &grf, k);
     controls.time[k] = forces.time[k] = knee.time[k] = metab.time[k] = t;
     double* kc = knee.data + GS_KNEE_COLUMNS * k;
-    knee_contact(m, d, kc);
+    knee_contact(m, d, kc, kc + 4);
     gsKneeReaction kr;
     kc[3] = have_left && gs_knee_reaction(m, d, &left_knee, NULL, &kr) == 0 ? kr.compression : NAN;
     peak_r = isfinite(kc[2]) && !isnan(peak_r) ? fmax(peak_r, kc[2]) : NAN;

@@ -1,7 +1,8 @@
-// cmd_report.c: `gaitsim report DIR [--out D] [--trial T]`: figures (PNG) and a Markdown table of
-// a solution folder, like Lin, Walter & Pandy 2018 Fig. 1-3 and Table 1. The work is done by
-// scripts/report.py (Debian python3-matplotlib), run as a child process without a shell; its exit
-// status is passed through.
+// cmd_report.c: `gaitsim report DIR [--out D] [--trial T] [--track TRACK_DIR]`: figures (PNG)
+// and a Markdown report of a solution folder, like Lin, Walter & Pandy 2018 Fig. 1-3 and Table 1,
+// or of a sweep folder (`gaitsim sweep`: sweep.csv, predict_<V>/), comparing the speeds like
+// their Fig. 4-6 and 8. The work is done by scripts/report.py (Debian python3-matplotlib), run as
+// a child process without a shell; its exit status is passed through.
 #include <errno.h>
 #include <getopt.h>
 #include <stdio.h>
@@ -16,34 +17,46 @@
 #define GS_REPORT_SCRIPT GAITSIM_SOURCE_DIR "/scripts/report.py"
 
 static const char* kReportUsage =
-    "usage: gaitsim report DIR [--out D] [--trial T]\n\n"
+    "usage: gaitsim report DIR [--out D] [--trial T] [--track TRACK_DIR]\n\n"
     "Figures and a table for a solution folder DIR (states.sto, controls.sto, grf.mot,\n"
     "summary.json; knee_contact.sto if present) against the measured trial it tracked, like Lin,\n"
     "Walter & Pandy 2018 Fig. 1-3 and Table 1: kinematics.png, grf.png (BW), knee_contact.png\n"
     "(when DIR has knee_contact.sto), excitations.png (right leg vs healthy EMG timing) and\n"
-    "report.md (RMS errors beside the paper's, solve facts, figure links). Each file is written\n"
-    "whole (temporary file + rename), and nothing is written on bad input. Needs Debian's\n"
-    "python3-matplotlib (" GS_REPORT_PYTHON ").\n\n"
-    "  --out D     output folder (default DIR/report)\n"
-    "  --trial T   measured trial folder (default: summary.json \"trial\", else\n"
-    "              mjmodels/trials/jw_ngait_og5)\n";
+    "report.md (RMS errors beside the paper's, solve facts, figure links).\n\n"
+    "For a sweep folder DIR (gaitsim sweep: sweep.csv, predict_V/), figures comparing the speeds\n"
+    "and the tracking solution, like the paper's Fig. 4-6 and 8: kinematics.png, grf.png,\n"
+    "excitations.png (main right-leg muscles), knee_contact.png (right and left knee), and\n"
+    "gait_parameters.png (stride time, stride length, cost of transport against speed, the\n"
+    "paper's values marked); report.md with the sweep table.\n\n"
+    "Each file is written whole (temporary file + rename), and nothing is written on bad input.\n"
+    "Needs Debian's python3-matplotlib (" GS_REPORT_PYTHON ").\n\n"
+    "  --out D           output folder (default DIR/report)\n"
+    "  --trial T         measured trial folder (default: summary.json \"trial\", else\n"
+    "                    mjmodels/trials/jw_ngait_og5)\n"
+    "  --track TRACK_DIR sweep folders: the tracking solution to draw beside the speeds\n"
+    "                    (default: the \"guess\" in the predictions' summary.json, if found)\n";
 
 int gs_cmd_report(int argc, char** argv) {
   static const struct option options[] = {{"out", required_argument, NULL, 'o'},
                                           {"trial", required_argument, NULL, 't'},
+                                          {"track", required_argument, NULL, 'k'},
                                           {"help", no_argument, NULL, 'h'},
                                           {NULL, 0, NULL, 0}};
   const char* out = NULL;
   const char* trial = NULL;
+  const char* track = NULL;
   optind = 1;
   int c;
-  while ((c = getopt_long(argc, argv, "o:t:h", options, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, "o:t:k:h", options, NULL)) != -1) {
     switch (c) {
       case 'o':
         out = optarg;
         break;
       case 't':
         trial = optarg;
+        break;
+      case 'k':
+        track = optarg;
         break;
       case 'h':
         fputs(kReportUsage, stdout);
@@ -58,9 +71,9 @@ int gs_cmd_report(int argc, char** argv) {
     return GS_EXIT_USAGE;
   }
 
-  // the child's arguments: python3 report.py DIR [--out D] [--trial T]; "--" keeps a DIR that
-  // starts with '-' a folder name
-  char* args[9];
+  // the child's arguments: python3 report.py [--out D] [--trial T] [--track K] -- DIR; "--"
+  // keeps a DIR that starts with '-' a folder name
+  char* args[11];
   int n = 0;
   args[n++] = (char*)GS_REPORT_PYTHON;
   args[n++] = (char*)GS_REPORT_SCRIPT;
@@ -71,6 +84,10 @@ int gs_cmd_report(int argc, char** argv) {
   if (trial) {
     args[n++] = (char*)"--trial";
     args[n++] = (char*)trial;
+  }
+  if (track) {
+    args[n++] = (char*)"--track";
+    args[n++] = (char*)track;
   }
   args[n++] = (char*)"--";
   args[n++] = argv[optind];

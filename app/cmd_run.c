@@ -19,7 +19,8 @@ static const char* kRunUsage =
     "     continued), polished to a dynamically consistent point when it stops short;\n"
     "  2. DIR/sweep/predict_V: predictive solves at the speeds of LIST (default 0.8:0.4:2.0 m/s,\n"
     "     gaitsim sweep: 0.8 continued from 1.2, 2.0 from 1.6) from it, DIR/sweep/sweep.md;\n"
-    "  3. DIR/*/report/: figures and report.md of every solution;\n"
+    "  3. DIR/*/report/: figures and report.md of every solution, DIR/sweep/report/: the speeds\n"
+    "     side by side (kinematics, GRF, excitations, stride and cost against speed, knee);\n"
     "  4. DIR/*/gait.mp4 and strip.png: video (3 strides) and filmstrip of every solution.\n"
     "Results in DIR (default results/). Exit status 0 when every solve converged, 3 when one\n"
     "stopped short (its best iterate written), else as the failing step.\n\n"
@@ -134,8 +135,12 @@ int gs_cmd_run(int argc, char** argv) {
     printf("[3] report%s of %s\n", video ? ", video and filmstrip" : "", dirs[i]);
     if ((rc = show(dirs[i], video)) != GS_EXIT_OK) return rc;
   }
+  // the speeds side by side (Lin, Walter & Pandy 2018, Fig. 4-6 and 8 style)
+  printf("[3] report of the sweep %s\n", sweep_dir);
+  const char* w_sweep_report[] = {"report", sweep_dir, "--track", track, NULL};
+  if ((rc = sub(gs_cmd_report, w_sweep_report)) != GS_EXIT_OK) return rc;
   printf("run: results in %s (track/, sweep/predict_*/: summary.json, *.sto, grf.mot, report/%s; "
-         "sweep/sweep.md)%s\n",
+         "sweep/sweep.md, sweep/report/)%s\n",
          out, video ? ", gait.mp4, strip.png" : "",
          stopped_short ? "; a solve stopped short: its best iterate, polished, is written" : "");
   return stopped_short ? GS_EXIT_STOPPED_SHORT : GS_EXIT_OK;

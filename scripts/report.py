@@ -1,7 +1,7 @@
 #!/usr/bin/python3
-"""report.py: figures and a table for a gaitsim solution folder (`gaitsim report DIR`).
+"""report.py: figures and a table for a gaitsim solution or sweep folder (`gaitsim report DIR`).
 
-usage: /usr/bin/python3 scripts/report.py DIR [--out D] [--trial T]
+usage: /usr/bin/python3 scripts/report.py DIR [--out D] [--trial T] [--track TRACK_DIR]
 
 Like Lin, Walter & Pandy 2018 (Ann Biomed Eng 46:1216) Fig. 1-3 and Table 1, from a solution
 folder (states.sto, controls.sto, grf.mot, summary.json; knee_contact.sto if present) and the
@@ -21,7 +21,29 @@ coordinates.mot, grf.mot, trial.json, knee_contact.sto):
   normalised to its peak over the cycle: timing only;
 - report.md: the RMS errors of summary.json beside the paper's participant-2 values (Table 1),
   the solve facts, and links to the figures.
-Body weight: trial.json mass_kg x 9.80665 N. Output goes to DIR/report/ (or --out); every file is
+Body weight: trial.json mass_kg x 9.80665 N.
+
+A sweep folder (`gaitsim sweep`: sweep.csv and predict_<V>/ solution folders; recognised by its
+sweep.csv, or by --track) gets figures comparing the speeds like the paper's Fig. 4-6 and 8, each
+speed a colour (viridis, slow to fast) and the tracking solution dashed black (--track, else the
+first "guess" of the predictions' summary.json that is not one of the sweep's predict_* folders
+and exists, as written or relative to the sweep folder's parent or up to three folders above it):
+- kinematics.png: pelvis, lumbar, hip, knee, ankle and subtalar angles over % stride (Fig. 4);
+- grf.png: fore-aft and vertical GRF per foot in BW (Fig. 5);
+- excitations.png: the main right-leg muscles (SWEEP_MUSCLES: soleus, gastrocnemius, tibialis
+  anterior, vasti, rectus femoris, hamstrings, gluteus maximus and medius, iliacus, psoas) (Fig. 6);
+- gait_parameters.png: stride time, stride length and cost of transport against speed from
+  sweep.csv, with the paper's stride times at 0.8 and 2.0 m/s (1.30, 0.92 s predicted; 1.45, 0.93
+  s measured) and the stride lengths they imply marked;
+- knee_contact.png (when a solution has knee_contact.sto): right-knee total per speed, and the
+  left knee's contact_total_l where present (Fig. 8);
+- report.md: the sweep table, the paper's stride times beside this sweep's, figure links.
+sweep.csv needs speed_mps, stride_time_s, stride_length_m, cost_of_transport_j_per_kg_m (other
+columns are shown in the table); "nan" values (failed solves) are left out of the plots, as are
+speeds without a predict_<V>/states.sto (listed in report.md). Body weight per solution:
+summary.json body_weight_n, else its trial's mass.
+
+Output goes to DIR/report/ (or --out); every file is
 written whole (temporary file + rename), report.md last, and only after every input has been
 read and checked, so bad input (missing file or column, NaN) leaves nothing new: one line
 "gaitsim: FILE: reason" on stderr, exit 1. Debian python3-matplotlib and python3-numpy only.
@@ -500,23 +522,475 @@ def report_md(d, figures):
     return "\n".join(lines)
 
 
+# ---------------------------------------------------------------------------------------------
+# sweep reports: `gaitsim report SWEEP_DIR` (a folder with sweep.csv and predict_<V>/ folders,
+# written by `gaitsim sweep`), figures comparing the speeds like Lin et al. 2018 Fig. 4-6, 8
+
+SWEEP_REQUIRED = ["speed_mps", "stride_time_s", "stride_length_m", "cost_of_transport_j_per_kg_m"]
+
+# Fig. 4 style panels: (coordinate, title)
+SWEEP_KINEMATICS = [
+    ("pelvis_rz", "pelvis tilt"), ("pelvis_rx", "pelvis list"), ("pelvis_ry", "pelvis rotation"),
+    ("pelvis_ty", "pelvis ty (vertical)"), ("lumbar_extension", "lumbar extension"),
+    ("hip_flexion", "hip flexion R"), ("hip_adduction", "hip adduction R"),
+    ("hip_rotation", "hip rotation R"), ("knee_flexion", "knee flexion R"),
+    ("ankle_angle", "ankle angle R"),
+    ("hip_flexion_l", "hip flexion L"), ("hip_adduction_l", "hip adduction L"),
+    ("knee_flexion_l", "knee flexion L"), ("ankle_angle_l", "ankle angle L"),
+    ("subtalar_angle", "subtalar angle R"),
+]
+
+# Fig. 6 style panels: JW's right-leg muscles (controls.sto names) and the paper's groups
+SWEEP_MUSCLES = [
+    ("soleus", "SOL: soleus"), ("gasmed", "GAS: medial"), ("gaslat", "GAS: lateral"),
+    ("tibant", "TA: tibialis anterior"), ("vasmed", "VAS: medialis"), ("vaslat", "VAS: lateralis"),
+    ("vasint", "VAS: intermedius"), ("recfem", "RF: rectus femoris"),
+    ("bflh", "HAMS: biceps femoris long"), ("bfsh", "HAMS: biceps femoris short"),
+    ("semimem", "HAMS: semimembranosus"), ("semiten", "HAMS: semitendinosus"),
+    ("glmax1", "GMAX: superior"), ("glmax2", "GMAX: middle"), ("glmax3", "GMAX: inferior"),
+    ("glmed1", "GMED: anterior"), ("glmed2", "GMED: middle"), ("glmed3", "GMED: posterior"),
+    ("iliacus", "iliacus"), ("psoas", "psoas"),
+]
+
+# Lin et al. 2018 (p. 1223): predicted stride times 1.30 s at 0.8 m/s and 0.92 s at 2.0 m/s;
+# measured averages 1.45 and 0.93 s
+PAPER_STRIDE_TIME = [(0.8, 1.30), (2.0, 0.92)]
+PAPER_MEASURED_STRIDE_TIME = [(0.8, 1.45), (2.0, 0.93)]
+
+
+def is_sweep_dir(args):
+    """Sweep mode: DIR has sweep.csv, or --track was given, or DIR has predict_* folders and no
+    summary.json."""
+    d = args.dir
+    if os.path.isfile(os.path.join(d, "sweep.csv")) or args.track:
+        return True
+    if os.path.isdir(d) and not os.path.exists(os.path.join(d, "summary.json")):
+        return any(n.startswith("predict_") for n in os.listdir(d))
+    return False
+
+
+def read_sweep_csv(path):
+    """(header, rows): rows as dicts of the raw strings plus "_speed" and, for SWEEP_REQUIRED,
+    floats ("nan" allowed: a failed solve); sorted by speed. PrepError on a missing file, a
+    missing required column, a row of the wrong length, a non-numeric required value, a speed
+    that is not a positive number or repeated, or no rows."""
+    import csv
+    try:
+        with open(path, encoding="utf-8", newline="") as f:
+            lines = [(n, r) for n, r in enumerate(csv.reader(f), 1) if any(x.strip() for x in r)]
+    except FileNotFoundError:
+        raise PrepError(path, "file not found")
+    except (OSError, UnicodeDecodeError, csv.Error) as e:
+        raise PrepError(path, getattr(e, "strerror", None) or str(e) or "cannot read")
+    if not lines:
+        raise PrepError(path, "empty (no header line)")
+    header = [h.strip() for h in lines[0][1]]
+    missing = [c for c in SWEEP_REQUIRED if c not in header]
+    if missing:
+        raise PrepError(path, "missing column(s) " + ", ".join(missing))
+    rows = []
+    for lineno, fields in lines[1:]:
+        if len(fields) != len(header):
+            raise PrepError(path, f"line {lineno}: {len(fields)} fields, header has {len(header)}")
+        r = {h: x.strip() for h, x in zip(header, fields)}
+        for c in SWEEP_REQUIRED:
+            try:
+                r["_" + c] = float(r[c])
+            except ValueError:
+                raise PrepError(path, f"line {lineno}: {c} '{r[c]}' is not a number")
+        v = r["_speed_mps"]
+        if not (math.isfinite(v) and v > 0):
+            raise PrepError(path, f"line {lineno}: speed_mps '{r['speed_mps']}' is not a positive number")
+        if any(abs(v - q["_speed_mps"]) < 1e-9 for q in rows):
+            raise PrepError(path, f"line {lineno}: speed {v:g} m/s repeated")
+        r["_speed"] = v
+        r["_line"] = lineno
+        rows.append(r)
+    if not rows:
+        raise PrepError(path, "no data rows")
+    rows.sort(key=lambda q: q["_speed"])
+    return header, rows
+
+
+def predict_folder(sweep, v):
+    """DIR/predict_<V> as `gaitsim sweep` names it (%.4g), else a predict_* folder whose suffix
+    is the same number; None when there is none."""
+    p = os.path.join(sweep, f"predict_{v:.4g}")
+    if os.path.isdir(p):
+        return p
+    for name in sorted(os.listdir(sweep)):
+        if name.startswith("predict_"):
+            try:
+                if abs(float(name[len("predict_"):]) - v) < 1e-9:
+                    return os.path.join(sweep, name)
+            except ValueError:
+                pass
+    return None
+
+
+def solution_bw(sol, summary, trial_override):
+    """(body weight N, source text) of a solution: summary.json body_weight_n, else its trial's
+    trial.json mass_kg x g."""
+    bw = summary.get("body_weight_n")
+    if finite_number(bw) and bw > 0:
+        return float(bw), "summary.json body_weight_n"
+    trial = resolve_trial(summary, os.path.join(sol, "summary.json"), trial_override)
+    tj_path = os.path.join(trial, "trial.json")
+    tj = read_json(tj_path)
+    mass = tj.get("mass_kg")
+    if not finite_number(mass) or mass <= 0:
+        raise PrepError(tj_path, "mass_kg missing or not a positive number")
+    return mass * G, f"{tj_path} mass_kg x g"
+
+
+def load_sweep_solution(sol, trial_override, label):
+    """One solution folder of a sweep report: {"dir", "label", "summary", "states", "controls",
+    "grf", "knee" (or None), "bw"}, every column the figures use checked."""
+    spath = os.path.join(sol, "summary.json")
+    s = {"dir": sol, "label": label,
+         "summary": read_json(spath) if os.path.exists(spath) else {}}
+    s["states"] = Storage(os.path.join(sol, "states.sto"))
+    s["controls"] = Storage(os.path.join(sol, "controls.sto"))
+    s["grf"] = Storage(os.path.join(sol, "grf.mot"))
+    kpath = os.path.join(sol, "knee_contact.sto")
+    s["knee"] = Storage(kpath) if os.path.exists(kpath) else None
+    s["bw"], s["bw_source"] = solution_bw(sol, s["summary"], trial_override)
+    s["kin"] = {name: s["states"].coordinate(name) for name, _ in SWEEP_KINEMATICS}
+    s["grf_bw"] = {(side, comp): s["grf"].col(f"ground_force_{side}_{comp}") / s["bw"]
+                   for side in ("r", "l") for comp in ("vx", "vy")}
+    s["exc"] = {m: s["controls"].col(m) for m, _ in SWEEP_MUSCLES if s["controls"].has(m)}
+    if s["knee"] is not None:
+        s["knee_r"] = knee_series(s["knee"]).get("total")
+        if s["knee_r"] is None:
+            raise PrepError(kpath, "no right-knee total (or medial and lateral) contact column")
+        s["knee_r"] = s["knee_r"] / s["bw"]
+        s["knee_l"] = (s["knee"].col("contact_total_l") / s["bw"]
+                       if s["knee"].has("contact_total_l") else None)
+    return s
+
+
+def guess_candidates(g, sweep):
+    """Where a summary.json "guess" path may be: as written (absolute, or relative to the current
+    folder), else relative to the sweep folder's parent and the three folders above it (the
+    folder `gaitsim sweep` ran in)."""
+    if os.path.isabs(g):
+        return [g]
+    out = [g]
+    a = os.path.dirname(os.path.abspath(sweep))
+    for _ in range(4):
+        out.append(os.path.join(a, g))
+        a = os.path.dirname(a)
+    return out
+
+
+def find_track(args, sweep, solutions):
+    """(tracking solution folder or None, note): --track, else the first "guess" of the
+    predictions' summaries that is not one of the sweep's own predict_* folders and exists (with
+    states.sto)."""
+    if args.track:
+        if not os.path.isdir(args.track):
+            raise PrepError(args.track, "tracking solution folder not found (--track)")
+        return args.track, "--track"
+    own = {os.path.realpath(s["dir"]) for s in solutions}
+    named = []
+    for s in solutions:
+        g = s["summary"].get("guess")
+        if not isinstance(g, str) or not g or g in named:
+            continue
+        named.append(g)
+        if os.path.basename(os.path.normpath(g)).startswith("predict_"):
+            continue
+        for c in guess_candidates(g, sweep):
+            if os.path.isfile(os.path.join(c, "states.sto")) and os.path.realpath(c) not in own:
+                return c, f"the guess `{g}` of the predictions' summary.json"
+    if not named:
+        return None, "no \"guess\" in the predictions' summary.json and no --track"
+    return None, ("guess " + ", ".join(f"`{g}`" for g in named if not
+                                       os.path.basename(os.path.normpath(g)).startswith("predict_"))
+                  + " not found; pass --track DIR")
+
+
+def load_sweep(args):
+    sweep = args.dir
+    if not os.path.isdir(sweep):
+        raise PrepError(sweep, "not a folder")
+    d = {"dir": sweep, "csv_path": os.path.join(sweep, "sweep.csv")}
+    if args.track and not os.path.exists(d["csv_path"]):
+        raise PrepError(d["csv_path"], "file not found (--track needs a sweep folder)")
+    d["header"], d["rows"] = read_sweep_csv(d["csv_path"])
+    d["speeds"] = []
+    d["skipped"] = []
+    for r in d["rows"]:
+        v = r["_speed"]
+        sol = predict_folder(sweep, v)
+        if sol is None:
+            d["skipped"].append((v, f"no folder predict_{v:.4g}"))
+            continue
+        if not os.path.exists(os.path.join(sol, "states.sto")):
+            d["skipped"].append((v, f"no states.sto in {os.path.basename(sol)} (solve failed?)"))
+            continue
+        s = load_sweep_solution(sol, args.trial, f"{v:.4g} m/s")
+        s["speed"] = v
+        d["speeds"].append(s)
+    if not d["speeds"]:
+        raise PrepError(sweep, "no predict_<V> folder with states.sto for any speed of sweep.csv")
+    track, d["track_note"] = find_track(args, sweep, d["speeds"])
+    d["track"] = None
+    if track is not None:
+        t = load_sweep_solution(track, args.trial, "tracking")
+        v = t["summary"].get("speed_mps")
+        t["speed"] = float(v) if finite_number(v) else None
+        if t["speed"] is not None:
+            t["label"] = f"tracking ({t['speed']:.2f} m/s)"
+        d["track"] = t
+    d["muscles"] = [(m, title) for m, title in SWEEP_MUSCLES
+                    if any(m in s["exc"] for s in d["speeds"])]
+    if not d["muscles"]:
+        raise PrepError(d["speeds"][0]["controls"].path,
+                        "none of the right-leg muscles " + ", ".join(m for m, _ in SWEEP_MUSCLES))
+    d["missing_muscles"] = [m for m, _ in SWEEP_MUSCLES if m not in dict(d["muscles"])]
+    d["has_knee"] = any(s["knee"] is not None for s in d["speeds"])
+    d["has_knee_l"] = any(s["knee"] is not None and s["knee_l"] is not None for s in d["speeds"])
+    return d
+
+
+def speed_styles(d, plt):
+    """[(solution, colour, linestyle, width)]: speeds slow to fast in viridis, tracking black
+    dashed last (drawn on top)."""
+    cmap = plt.get_cmap("viridis")
+    n = len(d["speeds"])
+    out = [(s, cmap(0.05 + 0.85 * (k / (n - 1) if n > 1 else 0.5)), "-", 1.3)
+           for k, s in enumerate(d["speeds"])]
+    if d["track"] is not None:
+        out.append((d["track"], "black", "--", 1.2))
+    return out
+
+
+def sweep_legend(ax, styles):
+    """The speeds' legend, in the first panel (Debian's matplotlib 3.6 has no outside legends)."""
+    from matplotlib.lines import Line2D
+    handles = [Line2D([], [], color=c, linestyle=ls, linewidth=w) for _, c, ls, w in styles]
+    ax.legend(handles, [s["label"] for s, _, _, _ in styles], fontsize=5, loc="best")
+
+
+def fig_sweep_kinematics(d, plt):
+    n = len(SWEEP_KINEMATICS)
+    ncol = 5
+    nrow = (n + ncol - 1) // ncol
+    fig, axes = plt.subplots(nrow, ncol, figsize=(2.4 * ncol, 2.0 * nrow + 0.9),
+                             layout="constrained", squeeze=False)
+    axes = axes.ravel()
+    styles = speed_styles(d, plt)
+    for ax, (name, title) in zip(axes, SWEEP_KINEMATICS):
+        for s, c, ls, w in styles:
+            ax.plot(s["states"].pct, s["kin"][name], color=c, linestyle=ls, linewidth=w)
+        ax.set_title(title, fontsize=8)
+        panel_style(ax, "% stride", "m" if name in TRANSLATIONS else "deg")
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    sweep_legend(axes[0], styles)
+    fig.suptitle("Kinematics per speed (cf. Lin et al. 2018 Fig. 4), right heel strike to right "
+                 "heel strike", fontsize=9)
+    out = png_bytes(fig)
+    plt.close(fig)
+    return out
+
+
+def fig_sweep_grf(d, plt):
+    fig, axes = plt.subplots(2, 2, figsize=(8, 5.8), layout="constrained")
+    styles = speed_styles(d, plt)
+    for i, side in enumerate(("r", "l")):
+        for j, (comp, title) in enumerate((("vx", "fore-aft"), ("vy", "vertical"))):
+            ax = axes[i, j]
+            for s, c, ls, w in styles:
+                ax.plot(s["grf"].pct, s["grf_bw"][(side, comp)], color=c, linestyle=ls, linewidth=w)
+            ax.set_title(f"{'right' if side == 'r' else 'left'} foot, {title}", fontsize=8)
+            panel_style(ax, "% stride", "BW")
+    sweep_legend(axes[0, 0], styles)
+    fig.suptitle("Ground reaction forces per speed, BW (cf. Lin et al. 2018 Fig. 5)", fontsize=9)
+    out = png_bytes(fig)
+    plt.close(fig)
+    return out
+
+
+def fig_sweep_excitations(d, plt):
+    n = len(d["muscles"])
+    ncol = 5
+    nrow = (n + ncol - 1) // ncol
+    fig, axes = plt.subplots(nrow, ncol, figsize=(2.4 * ncol, 1.9 * nrow + 0.9),
+                             layout="constrained", squeeze=False)
+    axes = axes.ravel()
+    styles = speed_styles(d, plt)
+    for ax, (m, title) in zip(axes, d["muscles"]):
+        for s, c, ls, w in styles:
+            if m in s["exc"]:
+                ax.plot(s["controls"].pct, s["exc"][m], color=c, linestyle=ls, linewidth=w)
+        ax.set_title(f"{title} ({m})", fontsize=7)
+        panel_style(ax, "% stride", "excitation")
+        ax.set_ylim(bottom=0)
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    sweep_legend(axes[0], styles)
+    fig.suptitle("Right-leg muscle excitations per speed (cf. Lin et al. 2018 Fig. 6)", fontsize=9)
+    out = png_bytes(fig)
+    plt.close(fig)
+    return out
+
+
+def fig_sweep_gait(d, plt):
+    import numpy as np
+    fig, axes = plt.subplots(1, 3, figsize=(11, 3.6), layout="constrained")
+    v = np.array([r["_speed"] for r in d["rows"]])
+    t = d["track"]
+    tv = t["speed"] if t is not None else None
+    for ax, key, title, unit in zip(axes, SWEEP_REQUIRED[1:],
+                                    ("stride time", "stride length", "cost of transport"),
+                                    ("s", "m", "J/(kg m)")):
+        y = np.array([r["_" + key] for r in d["rows"]])
+        ok = np.isfinite(y)
+        ax.plot(v[ok], y[ok], color="tab:blue", marker="o", markersize=4, linewidth=1.2,
+                label="this sweep")
+        if key == "stride_time_s":
+            ax.plot(*zip(*PAPER_STRIDE_TIME), linestyle="none", marker="*", markersize=10,
+                    color="tab:red", label="Lin et al. 2018, predicted")
+            ax.plot(*zip(*PAPER_MEASURED_STRIDE_TIME), linestyle="none", marker="s",
+                    markersize=5, markerfacecolor="none", color="tab:red",
+                    label="Lin et al. 2018, measured mean")
+        elif key == "stride_length_m":
+            ax.plot([p[0] for p in PAPER_STRIDE_TIME], [p[0] * p[1] for p in PAPER_STRIDE_TIME],
+                    linestyle="none", marker="*", markersize=10, color="tab:red",
+                    label="Lin et al. 2018, predicted (speed x stride time)")
+        if t is not None and tv is not None:
+            T = t["summary"].get("stride_time_s")
+            ty = {"stride_time_s": T,
+                  "stride_length_m": tv * T if finite_number(T) else None,
+                  "cost_of_transport_j_per_kg_m": t["summary"].get("cost_of_transport_j_per_kg_m")}[key]
+            if finite_number(ty):
+                ax.plot([tv], [ty], linestyle="none", marker="x", markersize=7, color="black",
+                        label="tracking solution")
+        ax.set_title(title, fontsize=8)
+        ax.set_xlabel("speed (m/s)", fontsize=7)
+        ax.set_ylabel(unit, fontsize=7)
+        ax.tick_params(labelsize=6)
+        ax.grid(alpha=0.3, linewidth=0.5)
+        ax.legend(fontsize=6, loc="best")
+    fig.suptitle("Stride time, stride length and cost of transport against speed (sweep.csv)",
+                 fontsize=9)
+    out = png_bytes(fig)
+    plt.close(fig)
+    return out
+
+
+def fig_sweep_knee(d, plt):
+    left = d["has_knee_l"]
+    fig, axes = plt.subplots(1, 1 + left, figsize=(4.2 * (1 + left), 3.6), layout="constrained",
+                             squeeze=False)
+    styles = [st for st in speed_styles(d, plt) if st[0]["knee"] is not None]
+    for k, (key, title) in enumerate((("knee_r", "right knee (6-DOF implant), total"),
+                                      ("knee_l", "left knee (1-DOF), compressive joint "
+                                                 "reaction"))[:1 + left]):
+        ax = axes[0][k]
+        for s, c, ls, w in styles:
+            if s.get(key) is not None:
+                ax.plot(s["knee"].pct, s[key], color=c, linestyle=ls, linewidth=w)
+        ax.set_title(title, fontsize=8)
+        panel_style(ax, "% stride", "BW")
+    sweep_legend(axes[0][0], styles)
+    fig.suptitle("Knee contact force per speed, BW (cf. Lin et al. 2018 Fig. 8)", fontsize=9)
+    out = png_bytes(fig)
+    plt.close(fig)
+    return out
+
+
+def sweep_report_md(d, figures):
+    lines = ["# gaitsim sweep report", "",
+             f"Sweep `{os.path.abspath(d['dir'])}`: {len(d['rows'])} speed(s) in sweep.csv, "
+             f"{len(d['speeds'])} with a solution folder.", ""]
+    if d["track"] is not None:
+        lines += [f"Tracking solution `{os.path.abspath(d['track']['dir'])}` ({d['track_note']}).",
+                  ""]
+    else:
+        lines += [f"No tracking solution in the figures: {d['track_note']}.", ""]
+    sols = d["speeds"] + ([d["track"]] if d["track"] is not None else [])
+    bws = sorted({(round(s["bw"], 1), s["bw_source"]) for s in sols})
+    lines += ["Body weight (BW), each solution in its own: "
+              + "; ".join(f"{bw:.1f} N ({src})" for bw, src in bws) + ".", ""]
+    lines += ["## Sweep table (sweep.csv)", "",
+              "| " + " | ".join(d["header"]) + " |", "|" + "---|" * len(d["header"])]
+    for r in d["rows"]:
+        lines.append("| " + " | ".join(r[h] for h in d["header"]) + " |")
+    lines += ["", "Lin, Walter & Pandy 2018: predicted stride time 1.30 s at 0.8 m/s and 0.92 s at "
+              "2.0 m/s (measured means 1.45 and 0.93 s); stride length from those, 1.04 and 1.84 m.",
+              ""]
+    for pv, pt in PAPER_STRIDE_TIME:
+        r = next((q for q in d["rows"] if abs(q["_speed"] - pv) < 1e-9), None)
+        if r is not None and math.isfinite(r["_stride_time_s"]):
+            lines.append(f"- {pv:g} m/s: stride time {r['_stride_time_s']:.3f} s against the "
+                         f"paper's {pt:.2f} s ({100 * (r['_stride_time_s'] / pt - 1):+.1f} %).")
+    if lines[-1] != "":
+        lines.append("")
+    captions = {
+        "kinematics.png": "Pelvis, lumbar, hip, knee, ankle and subtalar angles over the stride "
+                          "(% from right heel strike) per speed, slow (dark) to fast (light), and "
+                          "the tracking solution dashed (cf. Fig. 4).",
+        "grf.png": "Fore-aft and vertical ground reaction forces per foot, in BW, per speed "
+                   "(cf. Fig. 5).",
+        "excitations.png": "Right-leg muscle excitations per speed: soleus, gastrocnemius, "
+                           "tibialis anterior, vasti, rectus femoris, hamstrings, gluteus maximus "
+                           "and medius, iliopsoas (cf. Fig. 6).",
+        "gait_parameters.png": "Stride time, stride length and cost of transport against speed from "
+                               "sweep.csv, with the paper's values at 0.8 and 2.0 m/s (red) and "
+                               "the tracking solution (x).",
+        "knee_contact.png": "Right-knee total contact force per speed in BW"
+                            + (", and the left (1-DOF) knee's compressive joint reaction"
+                               if d["has_knee_l"] else "") + " (cf. Fig. 8).",
+    }
+    lines += ["## Figures", ""]
+    for name in figures:
+        lines += [f"![{name}]({name})", "", captions[name], ""]
+    notes = [f"{v:.4g} m/s: {why}" for v, why in d["skipped"]]
+    if notes:
+        lines += ["Speeds of sweep.csv not in the figures: " + "; ".join(notes) + ".", ""]
+    if d["missing_muscles"]:
+        lines += ["Muscles not in any controls.sto: " + ", ".join(d["missing_muscles"]) + ".", ""]
+    if not d["has_knee"]:
+        lines += ["No knee_contact.sto in any solution folder: no knee contact figure.", ""]
+    return "\n".join(lines)
+
+
+def sweep_figures(d, plt):
+    figures = {"kinematics.png": fig_sweep_kinematics(d, plt), "grf.png": fig_sweep_grf(d, plt),
+               "excitations.png": fig_sweep_excitations(d, plt),
+               "gait_parameters.png": fig_sweep_gait(d, plt)}
+    if d["has_knee"]:
+        figures["knee_contact.png"] = fig_sweep_knee(d, plt)
+    return figures
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="gaitsim report", description=__doc__.splitlines()[0])
-    ap.add_argument("dir", help="solution folder")
+    ap.add_argument("dir", help="solution folder, or sweep folder (sweep.csv, predict_*/)")
     ap.add_argument("--out", default=None, help="output folder (default DIR/report)")
     ap.add_argument("--trial", default=None, help="measured trial folder (default: summary.json trial)")
+    ap.add_argument("--track", default=None,
+                    help="sweep folder only: the tracking solution (default: the predictions' guess)")
     args = ap.parse_args(argv)
     out = args.out or os.path.join(args.dir, "report")
     try:
-        d = load(args)
+        sweep = is_sweep_dir(args)
+        d = load_sweep(args) if sweep else load(args)
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
-        figures = {"kinematics.png": fig_kinematics(d, plt), "grf.png": fig_grf(d, plt)}
-        if d["knee"] is not None:
-            figures["knee_contact.png"] = fig_knee(d, plt)
-        figures["excitations.png"] = fig_excitations(d, plt)
-        text = report_md(d, list(figures))
+        if sweep:
+            figures = sweep_figures(d, plt)
+            text = sweep_report_md(d, list(figures))
+        else:
+            figures = {"kinematics.png": fig_kinematics(d, plt), "grf.png": fig_grf(d, plt)}
+            if d["knee"] is not None:
+                figures["knee_contact.png"] = fig_knee(d, plt)
+            figures["excitations.png"] = fig_excitations(d, plt)
+            text = report_md(d, list(figures))
         for name, data in figures.items():
             write_atomic(os.path.join(out, name), data)
         write_atomic(os.path.join(out, "report.md"), text)

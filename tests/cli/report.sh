@@ -10,21 +10,6 @@ set -u
 gaitsim=$1 src=$2
 source "$(dirname "$0")/../cli_common.bash"
 
-png_info() {  # "ok WxH" for a file with the PNG signature and an IHDR chunk, else "bad"
-  python3 -c '
-import struct, sys
-d = open(sys.argv[1], "rb").read(24)
-ok = d[:8] == b"\x89PNG\r\n\x1a\n" and d[12:16] == b"IHDR"
-print("ok %dx%d" % struct.unpack(">II", d[16:24]) if ok else "bad")' "$1" 2>/dev/null || echo bad
-}
-plausible_png() {  # plausible_png FILE: valid PNG, 400..4000 px each way, over 10 kB
-  local info w h
-  info=$(png_info "$1")
-  [[ $info == ok\ * ]] || return 1
-  w=${info#ok } h=${w#*x} w=${w%x*}
-  test "$w" -ge 400 -a "$w" -le 4000 -a "$h" -ge 300 -a "$h" -le 4000 -a "$(stat -c %s "$1")" -gt 10000
-}
-
 cp -r "$src/tests/fixtures/solution_small" sol
 cat >sol/summary.json <<EOF
 {

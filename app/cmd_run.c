@@ -11,7 +11,8 @@
 #include "app/gs_commands.h"
 
 static const char* kRunUsage =
-    "usage: gaitsim run [--out DIR] [--nodes N] [--threads N] [--max-time S] [--speeds LIST]\n"
+    "usage: gaitsim run [--out DIR] [--nodes N] [--threads N] [--max-iter N] [--max-time S]\n"
+    "                   [--speeds LIST]\n"
     "                   [--no-video]\n\n"
     "The default job on the bundled model and trial (mjmodels/jw_fullbody.xml,\n"
     "mjmodels/trials/jw_ngait_og5):\n"
@@ -24,7 +25,10 @@ static const char* kRunUsage =
     "  4. DIR/*/gait.mp4 and strip.png: video (3 strides) and filmstrip of every solution.\n"
     "Results in DIR (default results/). Exit status 0 when every solve converged, 3 when one\n"
     "stopped short (its best iterate written), else as the failing step.\n\n"
-    "  --max-time S   wall-clock limit of each predictive solve, s (default 200); the tracking\n"
+    "  --max-iter N   Ipopt iteration limit of each predictive solve (default 400: an iteration\n"
+    "                 budget, not a time limit, so that the results do not depend on the load\n"
+    "                 of the machine; about 200 s per speed on 2 quiet cores)\n"
+    "  --max-time S   wall-clock limit of each predictive solve, s (default none); the tracking\n"
     "                 solve stops after 600 iterations (1000 on a continued mesh)\n";
 
 // run one subcommand with the given words (argv[0] is the subcommand)
@@ -57,19 +61,22 @@ int gs_cmd_run(int argc, char** argv) {
   static const struct option options[] = {
       {"out", required_argument, NULL, 'o'},      {"nodes", required_argument, NULL, 'n'},
       {"threads", required_argument, NULL, 't'},  {"max-time", required_argument, NULL, 'T'},
+      {"max-iter", required_argument, NULL, 'i'},
       {"speeds", required_argument, NULL, 's'},   {"no-video", no_argument, NULL, 'V'},
       {"help", no_argument, NULL, 'h'},           {NULL, 0, NULL, 0}};
-  const char *out = "results", *nodes = "20", *threads = "2", *max_time = "200";
+  const char *out = "results", *nodes = "20", *threads = "2", *max_time = NULL;
+  const char* max_iter = "400";
   char speeds[256] = "0.8:0.4:2.0";
   int video = 1;
   optind = 1;
   int c;
-  while ((c = getopt_long(argc, argv, "o:n:t:T:s:Vh", options, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, "o:n:t:T:i:s:Vh", options, NULL)) != -1) {
     switch (c) {
       case 'o': out = optarg; break;
       case 'n': nodes = optarg; break;
       case 't': threads = optarg; break;
       case 'T': max_time = optarg; break;
+      case 'i': max_iter = optarg; break;
       case 's': snprintf(speeds, sizeof(speeds), "%s", optarg); break;
       case 'V': video = 0; break;
       case 'h': fputs(kRunUsage, stdout); return GS_EXIT_OK;
@@ -110,7 +117,8 @@ int gs_cmd_run(int argc, char** argv) {
   printf("[2] predictive solves at %s m/s by continuation from the tracking solution -> %s\n",
          speeds, sweep_dir);
   const char* w3[] = {"sweep", "--guess", track, "--speeds", speeds, "--out", sweep_dir,
-                      "--nodes", continued ? nodes : "20", "--max-time", max_time, NULL};
+                      "--nodes", continued ? nodes : "20", "--max-iter", max_iter,
+                      max_time ? "--max-time" : NULL, max_time, NULL};
   rc = sub(gs_cmd_sweep, w3);
   if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
   stopped_short |= rc == GS_EXIT_STOPPED_SHORT;

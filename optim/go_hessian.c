@@ -86,6 +86,18 @@ typedef struct go_hess_fd {
 static int fd_values(go_hess* h, const double* x, double obj_factor, const double* lambda,
                      double* vals);
 
+// obj_factor times the objective's exact diagonal (go_nlp_eval_hess_diag) added to vals, when
+// the problem has one (else its curvature is left out). 0, or -1 when it failed.
+static int add_objective_diagonal(go_hess* h, const double* x, double obj_factor, double* vals) {
+  go_nlp* nlp = h->nlp;
+  if (!go_nlp_has_hess_diag(nlp)) return 0;
+  if (go_nlp_eval_hess_diag(nlp, x, obj_factor, h->hdiag)) return -1;
+  for (int k = 0; k < nlp->N; k++)
+    for (int j = 0; j < nlp->nz; j++)
+      vals[(size_t)k * h->nnz_node + h->diag[j]] += h->hdiag[(size_t)k * nlp->nz + j];
+  return 0;
+}
+
 static int fail(char* err, int errsz, const char* msg, int a) {
   snprintf(err, (size_t)errsz, "hessian: %s %d", msg, a);
   return -1;
@@ -113,7 +125,10 @@ void go_hess_free(go_hess* h) {
   free(h);
 }
 
-int go_hess_create(go_hess** out, go_nlp* nlp, const go_elements* el, char* err, int errsz) {
+// the element structure and pattern; with secant != 0 also the state of the SR1 updates (the
+// element blocks, the previous point and Jacobians), which the finite-difference mode does not use
+static int hess_create(go_hess** out, go_nlp* nlp, const go_elements* el, int secant, char* err,
+                       int errsz) {
   *out = NULL;
   int nz = nlp->nz, np = nlp->np, N = nlp->N, E = el->n_elem;
   if (E < 0 || (E > 0 && (!el->row_ptr || !el->rows || !el->var_ptr || !el->vars)))
@@ -239,7 +254,9 @@ int go_hess_create(go_hess** out, go_nlp* nlp, const go_elements* el, char* err,
   free(local);
 
   // values and scratch
-  if (!rc) {
+  h->hdiag = malloc(sizeof(double) * (size_t)nlp->n);
+  if (!rc && !h->hdiag) rc = fail(err, errsz, "out of memory", 4);
+  if (!rc && secant) {
     size_t npath = (size_t)N * (size_t)nlp->nnz_p;
     h->B = calloc((size_t)N * (size_t)(h->b_node + 1), sizeof(double));
     h->b_init = calloc((size_t)N * (size_t)(E + 1), 1);
@@ -248,12 +265,11 @@ int go_hess_create(go_hess** out, go_nlp* nlp, const go_elements* el, char* err,
     h->Jp = malloc(sizeof(double) * (npath + 1));
     h->Jc = malloc(sizeof(double) * (npath + 1));
     h->jfull = malloc(sizeof(double) * ((size_t)nlp->nele + 1));
-    h->hdiag = malloc(sizeof(double) * (size_t)nlp->n);
     h->s = malloc(sizeof(double) * (size_t)h->vmax);
     h->y = malloc(sizeof(double) * (size_t)h->vmax);
-    if (!h->B || !h->b_init || !h->xp || !h->xj || !h->Jp || !h->Jc || !h->jfull || !h->hdiag ||
-        !h->s || !h->y)
-      rc = fail(err, errsz, "out of memory", 4);
+    if (!h->B || !h->b_init || !h->xp || !h->xj || !h->Jp || !h->Jc || !h->jfull || !h->s ||
+        !h->y)
+      rc = fail(err, errsz, "out of memory", 5);
   }
   if (rc) {
     go_hess_free(h);
@@ -261,6 +277,10 @@ int go_hess_create(go_hess** out, go_nlp* nlp, const go_elements* el, char* err,
   }
   *out = h;
   return 0;
+}
+
+int go_hess_create(go_hess** out, go_nlp* nlp, const go_elements* el, char* err, int errsz) {
+  return hess_create(out, nlp, el, 1, err, errsz);
 }
 
 int go_hess_nnz(const go_hess* h) { return h->nnz; }
@@ -271,6 +291,7 @@ void go_hess_structure(const go_hess* h, int* irow, int* jcol) {
 }
 
 void go_hess_note_jacobian(go_hess* h, const double* x, const double* jac) {
+  if (h->fd) return;  // the finite-difference mode evaluates its own partials
   const go_nlp* nlp = h->nlp;
   memcpy(h->xj, x, sizeof(double) * (size_t)nlp->n);
   memcpy(h->Jc, jac + nlp->off_path, sizeof(double) * (size_t)nlp->N * (size_t)nlp->nnz_p);
@@ -368,13 +389,7 @@ int go_hess_values(go_hess* h, const double* x, double obj_factor, const double*
         for (int j = 0; j <= i; j++) vk[h->emap[q++]] += B[i * v + j];
     }
   }
-  if (go_nlp_has_hess_diag(nlp)) {
-    if (go_nlp_eval_hess_diag(nlp, x, obj_factor, h->hdiag)) return -1;
-    for (int k = 0; k < N; k++)
-      for (int j = 0; j < nz; j++)
-        vals[(size_t)k * h->nnz_node + h->diag[j]] += h->hdiag[(size_t)k * nz + j];
-  }
-  return 0;
+  return add_objective_diagonal(h, x, obj_factor, vals);
 }
 
 // --- finite-difference mode -------------------------------------------------------------------
@@ -416,7 +431,7 @@ static int rpush(rvec* a, fd_read x, int pert) {
 
 int go_hess_create_fd(go_hess** out, go_nlp* nlp, const go_elements* el, char* err, int errsz) {
   if (errsz > 0) err[0] = 0;
-  if (go_hess_create(out, nlp, el, err, errsz) != 0) return -1;
+  if (hess_create(out, nlp, el, 0, err, errsz) != 0) return -1;
   go_hess* h = *out;
   int nz = nlp->nz, np = nlp->np, N = nlp->N, E = h->n_elem, rc = 0;
   go_hess_fd* f = calloc(1, sizeof(go_hess_fd));
@@ -424,13 +439,12 @@ int go_hess_create_fd(go_hess** out, go_nlp* nlp, const go_elements* el, char* e
   int* row_elem = malloc(sizeof(int) * (size_t)(np + 1));
   unsigned char* mark = calloc((size_t)nz * (size_t)nz, 1);
   int* local = malloc(sizeof(int) * (size_t)nz * (size_t)nz);
-  int* fpos = malloc(sizeof(int) * (size_t)nz);
   int* color = malloc(sizeof(int) * (size_t)nz);
   ivec drow = {0}, pa = {0}, pb = {0}, prow = {0}, prow_ptr = {0}, bptr = {0}, cptr = {0},
        cvar = {0}, cvptr = {0};
   rvec bread = {0}, cread = {0};
   h->fd = f;
-  if (!f || !has || !row_elem || !mark || !local || !fpos || !color) {
+  if (!f || !has || !row_elem || !mark || !local || !color) {
     rc = fail(err, errsz, "out of memory (finite-difference Hessian)", 0);
     goto done;
   }
@@ -446,11 +460,10 @@ int go_hess_create_fd(go_hess** out, go_nlp* nlp, const go_elements* el, char* e
   f->fvar = malloc(sizeof(int) * (size_t)(nz + 1));
   if (!f->fvar) rc = fail(err, errsz, "out of memory (finite-difference Hessian)", 1);
   for (int j = 0; j < nz && !rc; j++) {
-    fpos[j] = -1;
     if (nlp->analytic[j]) continue;
     int in = 0;
     for (int e = 0; e < E && !in; e++) in = HAS(e, j) != 0;
-    if (in) fpos[j] = f->nf, f->fvar[f->nf++] = j;
+    if (in) f->fvar[f->nf++] = j;
   }
   for (int j = 0; j < nz; j++) mark[(size_t)j * nz + j] = 1;
   // (A) diagonal rows and pairs
@@ -616,7 +629,7 @@ int go_hess_create_fd(go_hess** out, go_nlp* nlp, const go_elements* el, char* e
 #undef MARK
 #undef LOCAL
 done:
-  free(has), free(row_elem), free(mark), free(local), free(fpos), free(color);
+  free(has), free(row_elem), free(mark), free(local), free(color);
   free(drow.v), free(pa.v), free(pb.v), free(prow.v), free(prow_ptr.v), free(bptr.v);
   free(cptr.v), free(cvar.v), free(cvptr.v), free(bread.v), free(bread.pert), free(cread.v);
   free(cread.pert);
@@ -762,12 +775,7 @@ static int fd_values(go_hess* h, const double* x, double obj_factor, const doubl
     }
   }
   if (nlp->free_time) vals[h->nnz - 1] = 0;
-  if (go_nlp_has_hess_diag(nlp)) {
-    if (go_nlp_eval_hess_diag(nlp, x, obj_factor, h->hdiag)) return -1;
-    for (int k = 0; k < nlp->N; k++)
-      for (int j = 0; j < nlp->nz; j++)
-        vals[(size_t)k * h->nnz_node + h->diag[j]] += h->hdiag[(size_t)k * nlp->nz + j];
-  }
+  if (add_objective_diagonal(h, x, obj_factor, vals)) return -1;
   h->updates++;
   return 0;
 }

@@ -10,7 +10,7 @@
 
 enum { kLabelMax = 256 };
 
-static const char* kGrfLabels[18] = {
+const char* const gs_grf_labels[GS_GRF_NCOL] = {
     "ground_force_r_vx", "ground_force_r_vy", "ground_force_r_vz", "ground_force_r_px",
     "ground_force_r_py", "ground_force_r_pz", "ground_torque_r_x", "ground_torque_r_y",
     "ground_torque_r_z", "ground_force_l_vx", "ground_force_l_vy", "ground_force_l_vz",
@@ -197,7 +197,7 @@ void gs_state_table_set_row(const mjModel* m, const mjData* d, double time, gsTa
 }
 
 int gs_grf_table_create(int nrow, gsTable* t, char* err, int errsz) {
-  return gs_table_create(t, nrow, 18, kGrfLabels, err, errsz);
+  return gs_table_create(t, nrow, GS_GRF_NCOL, gs_grf_labels, err, errsz);
 }
 
 // world (Z up) vector -> OpenSim ground frame (Y up): (x, z, -y)

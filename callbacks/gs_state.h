@@ -52,6 +52,10 @@ void gs_state_table_set_row(const mjModel* m, const mjData* d, double time, gsTa
 // A ground reaction table (OpenSim ExternalLoads columns, both feet, 18 columns) of nrow rows;
 // gs_grf_table_set_row fills one row from the model's contact spheres (COP defined above 5 N).
 int gs_grf_table_create(int nrow, gsTable* t, char* err, int errsz);
+// the 18 column names of a ground reaction table, in that order (right then left foot: force
+// vx vy vz, centre of pressure px py pz, free moment x y z)
+#define GS_GRF_NCOL 18
+extern const char* const gs_grf_labels[GS_GRF_NCOL];
 void gs_grf_table_set_row(const mjModel* m, const mjData* d, double time, gsTable* t, int row);
 
 #endif  // GAITSIM_CALLBACKS_GS_STATE_H_

@@ -214,12 +214,6 @@ int go_gait_guess_from_solution(const go_gait* g, const gsTable* states, const g
 
 int go_gait_measured_wrenches(const go_gait* g, const gsTable* grf, go_foot_wrench* w, char* err,
                               int errsz) {
-  static const char* names[18] = {
-      "ground_force_r_vx", "ground_force_r_vy", "ground_force_r_vz", "ground_force_r_px",
-      "ground_force_r_py", "ground_force_r_pz", "ground_torque_r_x", "ground_torque_r_y",
-      "ground_torque_r_z", "ground_force_l_vx", "ground_force_l_vy", "ground_force_l_vz",
-      "ground_force_l_px", "ground_force_l_py", "ground_force_l_pz", "ground_torque_l_x",
-      "ground_torque_l_y", "ground_torque_l_z"};
   int N = go_gait_nodes(g);
   double T = go_gait_stride_time(g);
   if (!grf || grf->nrow < 2) {
@@ -232,7 +226,7 @@ int go_gait_measured_wrenches(const go_gait* g, const gsTable* grf, go_foot_wren
   double* times = (double*)calloc((size_t)N, sizeof(double));
   for (int k = 0; k < N; k++) times[k] = grf->time[0] + T * k / (N - 1);
   int status = -1;
-  if (times && gs_table_select(grf, names, 18, &sel, err, errsz) == 0 &&
+  if (times && gs_table_select(grf, gs_grf_labels, GS_GRF_NCOL, &sel, err, errsz) == 0 &&
       gs_table_resample(&sel, times, N, &rs, err, errsz) == 0) {
     for (int k = 0; k < N; k++) {
       for (int s = 0; s < 2; s++) {  // OpenSim (x, y up, z) -> world (x, -z, y)

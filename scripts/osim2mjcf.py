@@ -16,6 +16,7 @@ Usage:
 """
 import argparse
 import csv
+import json
 import math
 import os
 import xml.etree.ElementTree as ET
@@ -100,12 +101,13 @@ TENDON_KT = 35.0          # De Groote et al. 2016 tendon shape factor (-)
 # Hunt-Crossley sphere parameters (geom user row, gs_model_layout.h order)
 CONTACT_USER = [1.0e6, 2.0, 0.8, 0.8, 0.5, 0.2]
 # Contact spheres in the FOOT FRAME F of each foot (mjmodels/README.md, "Contact spheres"):
-# origin at the calcaneus origin, y up (normal of the sole) and x forward along the horizontal
-# projection of the calcaneus-origin -> mtp-joint-centre line, both in the standing pose
-# (ankle_angle = subtalar_angle = 0), z = x cross y (to the right). Values are for the right
-# foot with z lateral; the left foot mirrors z. Every sphere's bottom lies on the sole plane,
-# SOLE_DEPTH below the lower of the two calcaneus origins at the standing pose, so the centre
-# height is the radius. Spheres 1-4 go on the calcaneus, 5-6 on the toes (gs_model_layout.h).
+# origin at the calcaneus origin's projection on the sole plane, y = the sole's normal (up), x
+# forward along the projection of the calcaneus-origin -> mtp-joint-centre line on the sole, z =
+# x cross y (to the right). The sole plane is calibrated on the trial (calibrated_soles): the floor
+# as the calcaneus sees it while the foot is flat, lowered by the static penetration under body
+# weight. Values are for the right foot with z lateral; the left foot mirrors z. Every sphere's
+# bottom lies on the sole plane. Spheres 1-4 go on the calcaneus, 5-6 on the toes
+# (gs_model_layout.h).
 CONTACT_SPHERES = [
     # (index, x forward, z lateral, radius, on toes)
     (1, 0.015, -0.016, 0.032, False),   # heel, medial (under the calcaneal tuberosity)
@@ -115,9 +117,11 @@ CONTACT_SPHERES = [
     (5, 0.215, -0.028, 0.020, True),    # hallux
     (6, 0.195, 0.020, 0.020, True),     # lateral toes
 ]
-# sole plane below the calcaneus origin (m): 3dpredictsim's heel sphere, centre 0.010 below the
-# calcaneus origin with radius 0.032
-SOLE_DEPTH = 0.042
+# foot-flat frames of the trial: both the calcaneus origin and the toes origin slower than this
+# (m/s, central differences of the IK poses)
+FOOT_FLAT_SPEED = 0.1
+# gravity (m/s^2), as the MJCF's <option gravity>
+GRAVITY = 9.81
 
 EPS_ZERO = 1e-8           # |default value| below which a coordinate default counts as 0
 FD_STEP = 1e-5            # central-difference step for moment arms (rad or m)
@@ -1338,6 +1342,19 @@ def wrapped_moment_arms(model, muscle, pose, coordinates, methods):
 # trial poses (IK of ngait_og5, degrees and m)
 # ------------------------------------------------------------------------------------------------
 
+def read_heel_strikes(path):
+    """Heel-strike source times (s) per foot from a prepared trial's trial.json."""
+    try:
+        with open(path) as f:
+            t = json.load(f)
+        right = t["right_heel_strike_s"]
+        left = t["left_heel_strike_s"]
+    except (OSError, ValueError, KeyError) as e:
+        raise SystemExit("osim2mjcf: %s: no heel strikes (%s)" % (path, e))
+    as_list = lambda v: [float(u) for u in (v if isinstance(v, list) else [v])]
+    return {"r": as_list(right), "l": as_list(left)}
+
+
 def read_trial(path):
     with open(path) as f:
         rows = [r for r in csv.reader(line for line in f if not line.startswith("#"))]
@@ -1769,47 +1786,303 @@ def bisect(f, lo, hi, iterations=60):
     return 0.5 * (lo + hi)
 
 
-def contact_spheres(model, x):
-    """Contact spheres for body transforms x (the standing pose): CONTACT_SPHERES placed in each
-    foot frame F, every bottom on the horizontal sole plane SOLE_DEPTH below the lower calcaneus
-    origin. Returns ({body: [(geom name, local position, radius)]}, contact points (ground
-    frame, on the sole), sole height)."""
-    sole = min(x["calcaneus"][1][1], x["calcaneus_l"][1][1]) - SOLE_DEPTH
-    contacts, points = {}, []
+def static_sole_penetration(weight):
+    """Depth d (m) at which one foot's six spheres, all pressed d into the floor, carry `weight`
+    (N) by the elastic term of the Hunt-Crossley law, Fn = 4/3 E sqrt(R) d^(3/2)
+    (callbacks/gs_contact.h; E = CONTACT_USER[0], Pa)."""
+    e_mod = CONTACT_USER[0]
+    per_depth = sum(4.0 / 3.0 * e_mod * math.sqrt(r) for _, _, _, r, _ in CONTACT_SPHERES)
+    return (weight / per_depth) ** (2.0 / 3.0)
+
+
+def calibrated_soles(model, frames):
+    """The sole plane of each foot in its calcaneus frame, calibrated on the trial
+    (mjmodels/README.md, "Contact spheres and standing pose"): over the foot-flat frames (the
+    calcaneus and toes origins both slower than FOOT_FLAT_SPEED) the floor y = 0 seen from the
+    calcaneus is the plane n.p = c with n = R^T e_y and c = -y(origin); n and c are their means
+    (n normalised). The sole lies the static penetration under body weight below it
+    (static_sole_penetration), so the foot-flat poses of the trial load the spheres with about
+    one body weight. Returns ({"r"|"l": {"normal": n, "offset": c - depth, "frames": count,
+    "spread_deg": largest angle between a frame's n and the mean}}, depth (m))."""
+    weight = GRAVITY * sum(b["mass"] for b in model.bodies.values())
+    depth = static_sole_penetration(weight)
+    xs = [model.body_transforms(model.coordinate_values(p)) for _, p in frames]
+    times = [t for t, _ in frames]
+    soles = {}
+    for side, calc, toes in (("r", "calcaneus", "toes"), ("l", "calcaneus_l", "toes_l")):
+        normals, offsets = [], []
+        for i in range(1, len(frames) - 1):
+            dt = times[i + 1] - times[i - 1]
+            v_calc = vec_norm(vec_sub(xs[i + 1][calc][1], xs[i - 1][calc][1])) / dt
+            v_toes = vec_norm(vec_sub(xs[i + 1][toes][1], xs[i - 1][toes][1])) / dt
+            if v_calc < FOOT_FLAT_SPEED and v_toes < FOOT_FLAT_SPEED:
+                normals.append(list(xs[i][calc][0][1]))   # row y of R = R^T e_y
+                offsets.append(-xs[i][calc][1][1])
+        if len(normals) < 5:
+            raise SystemExit("osim2mjcf: the trial has %d foot-flat frames of the %s foot (< 5); "
+                             "cannot calibrate its sole" % (len(normals), side))
+        n = unit([sum(v[k] for v in normals) / len(normals) for k in range(3)])
+        spread = max(math.degrees(math.acos(max(-1.0, min(1.0, sum(a * b for a, b in zip(v, n))
+                                                          / vec_norm(v))))) for v in normals)
+        soles[side] = {"normal": n, "offset": sum(offsets) / len(offsets) - depth,
+                       "frames": len(normals), "spread_deg": spread}
+    return soles, depth
+
+
+def read_storage(path):
+    """An OpenSim storage (.mot/.sto) written by scripts/prepare_trial.py: (labels, rows)."""
+    try:
+        with open(path) as f:
+            lines = f.read().splitlines()
+        start = [i for i, line in enumerate(lines) if line.strip() == "endheader"][0] + 1
+        labels = lines[start].split("\t")
+        rows = [[float(v) for v in line.split("\t")] for line in lines[start + 1:] if line]
+    except (OSError, IndexError, ValueError) as e:
+        raise SystemExit("osim2mjcf: %s: not a storage file (%s)" % (path, e))
+    if any(len(r) != len(labels) for r in rows):
+        raise SystemExit("osim2mjcf: %s: a row's column count differs from the header" % path)
+    return labels, rows
+
+
+def nelder_mead(f, x0, steps, iterations=600, tol=1e-12):
+    """Minimise f from x0 by the Nelder-Mead simplex (initial edges `steps`), fixed budget."""
+    pts = [list(x0)] + [[v + (steps[i] if i == j else 0.0) for j, v in enumerate(x0)]
+                        for i in range(len(x0))]
+    vals = [f(p) for p in pts]
+    for _ in range(iterations):
+        order = sorted(range(len(pts)), key=lambda i: vals[i])
+        pts, vals = [pts[i] for i in order], [vals[i] for i in order]
+        if vals[-1] - vals[0] < tol:
+            break
+        centroid = [sum(p[j] for p in pts[:-1]) / (len(pts) - 1) for j in range(len(x0))]
+        move = lambda a: [c + a * (w - c) for c, w in zip(centroid, pts[-1])]
+        xr = move(-1.0)
+        fr = f(xr)
+        if fr < vals[0]:
+            xe = move(-2.0)
+            fe = f(xe)
+            pts[-1], vals[-1] = (xe, fe) if fe < fr else (xr, fr)
+        elif fr < vals[-2]:
+            pts[-1], vals[-1] = xr, fr
+        else:
+            xc = move(0.5)
+            fc = f(xc)
+            if fc < vals[-1]:
+                pts[-1], vals[-1] = xc, fc
+            else:
+                pts = [pts[0]] + [[a + 0.5 * (b - a) for a, b in zip(pts[0], p)]
+                                  for p in pts[1:]]
+                vals = [vals[0]] + [f(p) for p in pts[1:]]
+    best = min(range(len(pts)), key=lambda i: vals[i])
+    return pts[best], vals[best]
+
+
+# sphere groups whose placement fit_contact_spheres adjusts: heel (1, 4), forefoot (2, 3),
+# toes (5, 6)
+SPHERE_GROUPS = {1: "heel", 4: "heel", 2: "fore", 3: "fore", 5: "toes", 6: "toes"}
+
+
+def fit_contact_spheres(model, frames, soles, grf_path, stride_start):
+    """Fit each foot's sphere placement to the trial's vertical ground reaction (mjmodels/README.md,
+    "Contact spheres and standing pose"). Over the IK frames of the prepared stride (grf.mot of
+    scripts/prepare_trial.py, file time 0 = source time stride_start), with the measured poses,
+    the model's vertical force is the Hunt-Crossley law of callbacks/gs_contact.h, sum over the
+    six spheres of 4/3 E sqrt(R) d^1.5 (1 + 3/2 c d'), d the depth below the floor and d' its rate
+    (central differences of the poses). Four numbers per foot minimise the mean squared error
+    against the measured vertical force of that foot (in body weights), by Nelder-Mead: the heel
+    spheres' F x and the offsets along the sole normal of the heel, forefoot and toes spheres
+    (m; 0 = bottom on the sole). Sets soles[side]["heel_x"] and soles[side]["lift"] =
+    {group: offset} and returns {side: (rms before, rms after, BW)}."""
+    labels, rows = read_storage(grf_path)
+    weight = GRAVITY * sum(b["mass"] for b in model.bodies.values())
+    e_mod, c_diss = CONTACT_USER[0], CONTACT_USER[1]
+    t_end = stride_start + rows[-1][0]
+    idx = [i for i in range(1, len(frames) - 1) if stride_start <= frames[i][0] <= t_end]
+    xs = {i: model.body_transforms(model.coordinate_values(frames[i][1]))
+          for j in idx for i in (j - 1, j, j + 1)}
+    report = {}
     for side, calc, toes, zsign in (("r", "calcaneus", "toes", 1.0),
                                     ("l", "calcaneus_l", "toes_l", -1.0)):
-        org = x[calc][1]
-        fwd = vec_sub(x[toes][1], org)
-        ex = unit([fwd[0], 0.0, fwd[2]])
-        ey = [0.0, 1.0, 0.0]
-        ez = [ex[1] * ey[2] - ex[2] * ey[1], ex[2] * ey[0] - ex[0] * ey[2],
-              ex[0] * ey[1] - ex[1] * ey[0]]
+        col = labels.index("ground_force_%s_vy" % side)
+        times = [r[0] + stride_start for r in rows]
+        measured = []
+        for i in idx:
+            t = frames[i][0]
+            k = max(1, min(len(times) - 1, next((j for j, u in enumerate(times) if u >= t),
+                                                 len(times) - 1)))
+            a = (t - times[k - 1]) / (times[k] - times[k - 1])
+            measured.append(rows[k - 1][col] + a * (rows[k][col] - rows[k - 1][col]))
+        # height of a calcaneus-frame point p in frame i: y(origin) + (row y of R) . p, affine
+        lin = {i: (xs[i][calc][1][1], xs[i][calc][0][1]) for i in xs}
+        sole = soles[side]
+        ex, ez = foot_basis(xs[idx[0]], calc, toes, sole["normal"])
+
+        def force_error(par):
+            heel_x, lift = par[0], {"heel": par[1], "fore": par[2], "toes": par[3]}
+            centres = []
+            for k, fx, fz, r, _ in CONTACT_SPHERES:
+                centre = sphere_centre(sole, ex, ez, heel_x if SPHERE_GROUPS[k] == "heel" else fx,
+                                       zsign * fz, r)
+                centres.append((vec_add(centre, vec_scale(sole["normal"],
+                                                          lift[SPHERE_GROUPS[k]])), r))
+            acc = 0.0
+            for n_i, i in enumerate(idx):
+                dt = frames[i + 1][0] - frames[i - 1][0]
+                fz_total = 0.0
+                for centre, r in centres:
+                    h = lin[i][0] + dot(lin[i][1], centre) - r
+                    if h >= 0.0:
+                        continue
+                    rate = -((lin[i + 1][0] + dot(lin[i + 1][1], centre)) -
+                             (lin[i - 1][0] + dot(lin[i - 1][1], centre))) / dt
+                    fz_total += 4.0 / 3.0 * e_mod * math.sqrt(r) * (-h) ** 1.5 * max(
+                        0.0, 1.0 + 1.5 * c_diss * rate)
+                acc += ((fz_total - measured[n_i]) / weight) ** 2
+            return acc / len(idx)
+        start = [sole.get("heel_x", 0.015), 0.0, 0.0, 0.0]
+        before = math.sqrt(force_error(start))
+        best, val = nelder_mead(force_error, start, [0.01, 0.005, 0.005, 0.005])
+        sole["heel_x"] = best[0]
+        sole["lift"] = {"heel": best[1], "fore": best[2], "toes": best[3]}
+        report[side] = (before, math.sqrt(val))
+    return report
+
+
+def foot_basis(x, calc, toes, normal):
+    """Foot frame F's axes in the calcaneus frame: x forward (the calcaneus-origin -> toes-origin
+    line projected on the sole), z = x cross y (right), y the sole normal."""
+    toes_org = tf_point(tf_inv(x[calc]), x[toes][1])
+    ex = unit(vec_sub(toes_org, vec_scale(normal, dot(toes_org, normal))))
+    return ex, cross(ex, normal)
+
+
+def sphere_centre(sole, ex, ez, fx, fz, r):
+    """Centre (calcaneus frame) of a sphere of radius r whose bottom lies on the sole at F
+    coordinates (fx, fz)."""
+    n, c = sole["normal"], sole["offset"]
+    return vec_add(vec_scale(n, c + r), vec_add(vec_scale(ex, fx), vec_scale(ez, fz)))
+
+
+def place_heels(model, frames, soles, heel_strikes):
+    """Fore-aft position of the two heel spheres (1 and 4) in each foot frame F, calibrated on the
+    trial (mjmodels/README.md, "Contact spheres and standing pose"): at the IK frame nearest each
+    heel strike of that foot (trial.json, the force plates' 20 N onset) the heel spheres' bottoms
+    touch the floor (their mean height is 0; several heel strikes: the mean over them). The
+    height is linear in F x for a fixed pose, so two evaluations solve it. Sets
+    soles[side]["heel_x"] (m) and returns {side: (mean bottom height at the default x (m),
+    number of heel strikes)}."""
+    heels = [(k, fz, r) for k, fx, fz, r, on_toes in CONTACT_SPHERES if k in (1, 4)]
+    report = {}
+    for side, calc, toes, zsign in (("r", "calcaneus", "toes", 1.0),
+                                    ("l", "calcaneus_l", "toes_l", -1.0)):
+        poses = []
+        for t in heel_strikes[side]:
+            i = min(range(len(frames)), key=lambda j: abs(frames[j][0] - t))
+            if abs(frames[i][0] - t) > 0.02:
+                raise SystemExit("osim2mjcf: no IK frame within 20 ms of the %s heel strike at "
+                                 "%.4f s" % (side, t))
+            poses.append((frames[i][0], model.body_transforms(model.coordinate_values(
+                frames[i][1]))))
+
+        def mean_bottom(fx, poses=poses, calc=calc, toes=toes, zsign=zsign, side=side):
+            acc = 0.0
+            for _, x in poses:
+                ex, ez = foot_basis(x, calc, toes, soles[side]["normal"])
+                for _, fz, r in heels:
+                    centre = sphere_centre(soles[side], ex, ez, fx, zsign * fz, r)
+                    acc += tf_point(x[calc], centre)[1] - r
+            return acc / (len(poses) * len(heels))
+        default_x = [fx for k, fx, _, _, _ in CONTACT_SPHERES if k == 1][0]
+        h0, h1 = mean_bottom(default_x), mean_bottom(default_x - 0.01)
+        soles[side]["heel_x"] = soles[side]["heel_x_strike"] = default_x - 0.01 * h0 / (h0 - h1)
+        report[side] = (mean_bottom(default_x), len(poses))
+    return report
+
+
+def cross(a, b):
+    return [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+
+
+def dot(a, b):
+    return sum(u * v for u, v in zip(a, b))
+
+
+def contact_spheres(model, x, soles):
+    """Contact spheres on the calibrated soles (calibrated_soles): CONTACT_SPHERES placed in each
+    foot frame F, every bottom on the sole plane. x: body transforms (any pose; the toes spheres
+    need the calcaneus -> toes transform). Returns ({body: [(geom name, local position,
+    radius)]}, {side: [sphere bottoms, ground frame, at x]})."""
+    contacts, bottoms = {}, {}
+    for side, calc, toes, zsign in (("r", "calcaneus", "toes", 1.0),
+                                    ("l", "calcaneus_l", "toes_l", -1.0)):
+        sole = soles[side]
+        calc_to_toes = tf_mul(tf_inv(x[toes]), x[calc])
+        ex, ez = foot_basis(x, calc, toes, sole["normal"])
         for k, fx, fz, r, on_toes in CONTACT_SPHERES:
-            height = sole + r - org[1]
-            world = vec_add(org, vec_add(vec_add(vec_scale(ex, fx), vec_scale(ey, height)),
-                                         vec_scale(ez, zsign * fz)))
+            if k in (1, 4) and "heel_x" in sole:
+                fx = sole["heel_x"]
+            centre = sphere_centre(sole, ex, ez, fx, zsign * fz, r)
+            centre = vec_add(centre, vec_scale(sole["normal"],
+                                               sole.get("lift", {}).get(SPHERE_GROUPS[k], 0.0)))
+            bottom = vec_sub(centre, vec_scale(sole["normal"], r))
             body = toes if on_toes else calc
-            local = tf_point(tf_inv(x[body]), world)
+            local = tf_point(calc_to_toes, centre) if on_toes else centre
             contacts.setdefault(body, []).append(("contact_%s_%d" % (side, k), local, r))
-            points.append([world[0], sole, world[2]])
-    return contacts, points, sole
+            bottoms.setdefault(side, []).append(tf_point(x[calc], bottom))
+    return contacts, bottoms
 
 
-def standing_pose(model, zero, frames):
+def solve_newton(residual, u, tol=1e-12, iterations=30, step=1e-7):
+    """Root of residual(u) = 0 (as many equations as unknowns) by Newton's method with a
+    forward-difference Jacobian and Gaussian elimination with partial pivoting."""
+    u = list(u)
+    for _ in range(iterations):
+        r = residual(u)
+        if max(abs(v) for v in r) < tol:
+            return u
+        n = len(u)
+        jac = [[0.0] * n for _ in range(n)]
+        for j in range(n):
+            up = list(u)
+            up[j] += step
+            rp = residual(up)
+            for i in range(n):
+                jac[i][j] = (rp[i] - r[i]) / step
+        a = [row + [-r[i]] for i, row in enumerate(jac)]
+        for col in range(n):
+            piv = max(range(col, n), key=lambda i: abs(a[i][col]))
+            a[col], a[piv] = a[piv], a[col]
+            for i in range(col + 1, n):
+                f = a[i][col] / a[col][col]
+                a[i] = [vi - f * vc for vi, vc in zip(a[i], a[col])]
+        du = [0.0] * n
+        for i in reversed(range(n)):
+            du[i] = (a[i][n] - sum(a[i][j] * du[j] for j in range(i + 1, n))) / a[i][i]
+        u = [ui + di for ui, di in zip(u, du)]
+    r = residual(u)
+    if max(abs(v) for v in r) > 1e-9:
+        raise SystemExit("osim2mjcf: the standing pose did not converge (residual %.3g)"
+                         % max(abs(v) for v in r))
+    return u
+
+
+def standing_pose(model, zero, frames, soles):
     """The `standing` pose (= qpos0) and the contact spheres, computed (mjmodels/README.md,
     "Standing pose"):
     1. pelvic tilt relative to the legs and lumbar_extension: the means over the IK trial;
-       other coordinates 0 (right knee's secondary coordinates at their defaults), knees 0,
-       ankle_angle = subtalar_angle = 0;
+       other coordinates 0 (right knee's secondary coordinates at their defaults), knees 0;
     2. per leg, hip_flexion and hip_adduction such that the ankle centre (talus origin) lies
        vertically below the hip centre (femur origin) with the pelvis at the trial's mean tilt
        (legs vertical), hip_rotation such that the foot axis (calcaneus origin -> mtp centre)
        points straight ahead (X);
-    3. the whole body leans forward by `lean` about the feet (pelvis_rz = mean tilt - lean, hips
-       as in 2, so the legs lean with it); for each lean the contact spheres are placed level
-       at that pose (contact_spheres) and lean is solved (bisection) so that the whole-body COM
-       lies over the middle of the fore-aft span of the 12 contact points;
-    4. pelvis_ty such that the sole is at height 0 (every sphere bottom touches the floor).
+    3. Newton's method on six unknowns: per foot ankle_angle and subtalar_angle level its four
+       calcaneus spheres (forefoot pair as high as the heel pair, medial pair as high as the
+       lateral pair), pelvis_rx (pelvic list) puts both feet's spheres at one mean height,
+       and the whole body leans forward by `lean` about the feet (pelvis_rz = mean tilt - lean,
+       the legs lean with it) so that the whole-body COM lies over the middle of the fore-aft
+       span of the 8 calcaneus sphere bottoms;
+    4. pelvis_ty such that the calcaneus spheres' mean bottom height is 0 (the toes spheres,
+       lifted by fit_contact_spheres, clear the floor).
     Returns (pose, {body: [(geom name, local position, radius)]}, report dict)."""
     pose = dict(zero)
     tilt = sum(f[1]["pelvis_rz"] for f in frames) / len(frames)
@@ -1834,27 +2107,49 @@ def standing_pose(model, zero, frames):
                     p[c] = q
                     return e(xform(p))
                 pose[coord + sfx] = bisect(f, -0.6, 0.6)
-    def com_ahead(lean):
+    unknowns = ["ankle_angle", "subtalar_angle", "ankle_angle_l", "subtalar_angle_l",
+                "pelvis_rx", "lean"]
+
+    def posed(u):
         p = dict(pose)
-        p["pelvis_rz"] = tilt - lean
-        x = xform(p)
-        _, points, _ = contact_spheres(model, x)
-        xs = [q[0] for q in points]
-        return whole_body_com(model, x)[0] - 0.5 * (min(xs) + max(xs))
-    lean = bisect(com_ahead, -0.3, 0.3)
-    pose["pelvis_rz"] = tilt - lean
-    contacts, points, sole = contact_spheres(model, xform(pose))
-    pose["pelvis_ty"] = -sole
+        for name, v in zip(unknowns[:5], u[:5]):
+            p[name] = v
+        p["pelvis_rz"] = tilt - u[5]
+        return p
+
+    def calcaneus_bottoms(x):
+        """Bottom heights of spheres 1-4 per foot: {side: {index: height}}."""
+        _, bottoms = contact_spheres(model, x, soles)
+        return {side: {k: bottoms[side][k - 1][1] for k in (1, 2, 3, 4)} for side in bottoms}
+
+    def residual(u):
+        x = xform(posed(u))
+        h = calcaneus_bottoms(x)
+        level = []
+        for side in ("r", "l"):
+            b = h[side]
+            level += [0.5 * (b[2] + b[3]) - 0.5 * (b[1] + b[4]),   # forefoot - heel
+                      0.5 * (b[1] + b[2]) - 0.5 * (b[3] + b[4])]   # medial - lateral
+        _, bottoms = contact_spheres(model, x, soles)
+        fwd = [b[0] for side in bottoms for b in bottoms[side][:4]]   # spheres 1-4 stand
+        return level + [sum(h["r"].values()) / 4.0 - sum(h["l"].values()) / 4.0,
+                        whole_body_com(model, x)[0] - 0.5 * (min(fwd) + max(fwd))]
+
+    u = solve_newton(residual, [0.0] * 6)
+    pose = posed(u)
     x = xform(pose)
-    com = whole_body_com(model, x)
-    points = [[q[0], 0.0, q[2]] for q in points]
-    report = {"com": com, "points": points, "lean": lean, "tilt": tilt,
+    contacts, _ = contact_spheres(model, x, soles)
+    pose["pelvis_ty"] = -sum(calcaneus_bottoms(x)["r"].values()) / 4.0
+    x = xform(pose)
+    _, bottoms = contact_spheres(model, x, soles)
+    points = bottoms["r"] + bottoms["l"]
+    report = {"com": whole_body_com(model, x), "points": points, "lean": u[5], "tilt": tilt,
               "ankle_r": x["talus"][1], "ankle_l": x["talus_l"][1]}
     return pose, contacts, report
 
 
 class Converter:
-    def __init__(self, model, metabolic, frames, osim_name):
+    def __init__(self, model, metabolic, frames, osim_name, heel_strikes, grf_path):
         self.model = model
         self.metabolic = metabolic
         self.frames = frames
@@ -1866,7 +2161,12 @@ class Converter:
         self.x0 = model.body_transforms(model.coordinate_values(zero))
         # the standing pose is the model's reference configuration: qpos0 = `ref` = standing,
         # so stock tools start standing (mjmodels/README.md, "Standing pose")
-        self.standing, self.contacts, self.standing_report = standing_pose(model, zero, frames)
+        self.soles, self.sole_depth = calibrated_soles(model, frames)
+        self.heel_report = place_heels(model, frames, self.soles, heel_strikes)
+        self.fit_report = fit_contact_spheres(model, frames, self.soles, grf_path,
+                                              heel_strikes["r"][0])
+        self.standing, self.contacts, self.standing_report = standing_pose(model, zero, frames,
+                                                                           self.soles)
         self.defaults = self.standing
         self.values0 = model.coordinate_values(self.defaults)
         self.children = {}
@@ -2205,7 +2505,13 @@ def main():
                     help="IK csv (default: <osim dir>/../ngait_og5/IK_ngait_og5.csv)")
     ap.add_argument("--knee-params", default=None,
                     help="mjmodels/knee/jw_knee.json: add the gs_knee numerics (opt-in)")
+    ap.add_argument("--trial-events", default=os.path.join(
+        os.path.dirname(os.path.abspath(__file__)), "..", "mjmodels", "trials", "jw_ngait_og5",
+        "trial.json"), help="trial.json of scripts/prepare_trial.py: the heel strikes (source "
+                            "times) that place the heel spheres; grf.mot next to it is fitted "
+                            "(default: the bundled trial's)")
     args = ap.parse_args()
+    heel_strikes = read_heel_strikes(args.trial_events)
     trial = args.trial_ik or os.path.join(os.path.dirname(os.path.abspath(args.osim)), "..",
                                           "ngait_og5", "IK_ngait_og5.csv")
     model = OsimModel(args.osim)
@@ -2221,7 +2527,25 @@ def main():
     for name, short, old, new in floor_fibre_shortening(model, frames):
         print("lts %-11s lM/lopt min %.3f: %.4f -> %.4f m (%+.1f %%)" % (
             name, short, old, new, 100.0 * (new / old - 1.0)))
-    conv = Converter(model, metabolic, frames, os.path.basename(args.osim))
+    conv = Converter(model, metabolic, frames, os.path.basename(args.osim), heel_strikes,
+                     os.path.join(os.path.dirname(os.path.abspath(args.trial_events)), "grf.mot"))
+    for side in ("r", "l"):
+        sole = conv.soles[side]
+        print("sole %s: normal %s, offset %.4f m in the calcaneus frame (%d foot-flat frames, "
+              "spread %.1f deg, static penetration %.1f mm)" % (
+                  side, " ".join("%.4f" % v for v in sole["normal"]), sole["offset"],
+                  sole["frames"], sole["spread_deg"], 1000.0 * conv.sole_depth))
+        print("heel %s: spheres 1 and 4 at F x = %.4f m (with the default x their bottoms are "
+              "%.1f mm above the floor at the %d heel strike(s))" % (
+                  side, sole["heel_x_strike"], 1000.0 * conv.heel_report[side][0],
+                  conv.heel_report[side][1]))
+        print("fit %s: vertical GRF RMS %.3f -> %.3f BW; heel x %.4f m, lift heel %.4f, fore "
+              "%.4f, toes %.4f m" % ((side,) + conv.fit_report[side] + (sole["heel_x"],) + tuple(
+                  sole["lift"][g] for g in ("heel", "fore", "toes"))))
+    print("standing: " + ", ".join("%s %.2f deg" % (c, math.degrees(conv.standing[c])) for c in (
+        "pelvis_rz", "pelvis_rx", "ankle_angle", "subtalar_angle", "ankle_angle_l",
+        "subtalar_angle_l")) + ", lean %.2f deg, pelvis_ty %.4f m" % (
+        math.degrees(conv.standing_report["lean"]), conv.standing["pelvis_ty"]))
     conv.write(args.out)
     if args.knee_params:
         add_knee_params(args.out, args.knee_params)

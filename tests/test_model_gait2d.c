@@ -85,7 +85,15 @@ int main(void) {
   mjData* d = mj_makeData(m);
   if (key >= 0) {
     mj_resetDataKeyframe(m, d, key);
-    EXPECT_NEAR(1.0230, d->qpos[1], 1e-3);  // pelvis_ty as in jw_fullbody.xml
+    // pelvis_ty as at jw_fullbody.xml's standing keyframe
+    int full_key = mj_name2id(full, mjOBJ_KEY, "standing");
+    int full_ty = mj_name2id(full, mjOBJ_JOINT, "pelvis_ty");
+    EXPECT_TRUE(full_key >= 0 && full_ty >= 0);
+    if (full_key >= 0 && full_ty >= 0) {
+      double ty = full->key_qpos[full_key * full->nq + full->jnt_qposadr[full_ty]];
+      EXPECT_NEAR(ty, d->qpos[1], 1e-3);
+      EXPECT_TRUE(ty > 0.95 && ty < 1.05);  // JW's standing pelvis height (m)
+    }
     mj_fwdPosition(m, d);
     for (int a = 0; a < m->nu; a++) {
       double best = 0;
@@ -99,18 +107,22 @@ int main(void) {
                 mj_id2name(m, mjOBJ_ACTUATOR, a), best);
       }
     }
-    // every contact sphere touches the floor (z = 0) within 1 mm: level feet (mjmodels/README.md)
-    double low = 1e9, high = -1e9;
+    // the calcaneus spheres (1-4) touch the floor (z = 0) within 1 mm: level feet; the toes
+    // spheres (5, 6), lifted by the converter's GRF fit, clear it by 0-20 mm (mjmodels/README.md)
+    double low = 1e9, high = -1e9, toes_low = 1e9, toes_high = -1e9;
     for (int g = 0; g < m->ngeom; g++) {
       const char* name = mj_id2name(m, mjOBJ_GEOM, g);
       if (name && !strncmp(name, "contact_", 8)) {
         double z = d->geom_xpos[3 * g + 2] - m->geom_size[3 * g];
-        low = z < low ? z : low;
-        high = z > high ? z : high;
+        int toes = name[strlen(name) - 1] == '5' || name[strlen(name) - 1] == '6';
+        double *lo = toes ? &toes_low : &low, *hi = toes ? &toes_high : &high;
+        *lo = z < *lo ? z : *lo;
+        *hi = z > *hi ? z : *hi;
       }
     }
     EXPECT_NEAR(0.0, low, 1e-3);
     EXPECT_NEAR(0.0, high, 1e-3);
+    EXPECT_TRUE(toes_low > -1e-3 && toes_high < 0.02);
   }
 
   mj_deleteData(d);

@@ -1,23 +1,26 @@
 #!/usr/bin/env bash
 # Issue #4: the full-body model, every joint but the pelvis held, actuators off, dropped from
-# 2 cm above its `standing` keyframe, comes to rest on its 12 contact spheres within 1 s without
-# NaN: over the last 0.2 s the total vertical GRF is within 5 % of body weight, both feet carry
-# load (each > 20 % BW, i.e. all of its spheres are on the floor) and the pelvis speeds are below
-# 0.01 m/s or rad/s.
+# 2 cm above its `standing` keyframe, comes to rest on its 8 calcaneus contact spheres within 4 s
+# without NaN (the toes spheres, lifted by the converter's GRF fit, clear the floor when standing):
+# over the last 0.2 s the total vertical GRF is within 5 % of body weight, both feet carry load
+# (each > 20 % BW) and the pelvis speeds are below 0.01 m/s or rad/s. Since the trial-calibrated
+# feet (mjmodels/README.md, "Contact spheres and standing pose") the held body sways sideways at
+# about 1.7 Hz and settles more slowly than on the earlier 12 level spheres (largest pelvis speed
+# 0.012 at 0.85 s, 0.010 over 2.8-3.0 s, 0.008 over 3.8-4.0 s), hence 4 s instead of 1 s.
 # usage: hold_drop.sh GAITSIM SOURCE_DIR
 set -u
 gaitsim=$(cd "$(dirname "$1")" && pwd)/$(basename "$1") src=$(cd "$2" && pwd)
 model=$src/mjmodels/jw_fullbody.xml
 source "$(dirname "$0")/../cli_common.bash"
 
-"$gaitsim" simulate "$model" --hold --drop 0.02 --duration 1 --rate 100 --out run >/dev/null
+"$gaitsim" simulate "$model" --hold --drop 0.02 --duration 4 --rate 100 --out run >/dev/null
 check "simulate exits 0" test $? -eq 0
 mass=$("$gaitsim" info "$model" --json | awk -F: '/"mass_kg"/ { gsub(/[ ,]/, "", $2); print $2 }')
 check "info reports the mass ($mass)" awk -v m="$mass" 'BEGIN { exit !(m > 10) }'
 
 # columns by name after `endheader`; rows with time >= 0.8 s
 summary() {  # file, then awk program reading the named columns
-  awk -F'\t' -v t0=0.7999 "
+  awk -F'\t' -v t0=3.7999 "
     hdr { for (i = 1; i <= NF; i++) col[\$i] = i; hdr = 0; next }
     /^endheader/ { hdr = 1; next }
     col[\"time\"] && \$1 + 0 >= t0 { $2 }

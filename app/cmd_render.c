@@ -20,7 +20,8 @@ static const char* kRenderUsage =
     "usage: gaitsim render SOLUTION_DIR [--model MODEL] OUTPUT [options]\n"
     "       gaitsim render MODEL.xml --pose FILE OUTPUT [options]\n\n"
     "Off-screen rendering (OSMesa, no display or GPU) of a solution folder (states.sto,\n"
-    "controls.sto, grf.mot, optional knee_contact.sto) on MODEL (default the bundled model; any\n"
+    "controls.sto, grf.mot, optional knee_contact.sto) on MODEL (default the model its\n"
+    "summary.json names, else the bundled model; any\n"
     "MuJoCo model with the same joint names), or of a pose file (states.sto, coordinates.mot).\n"
     "Muscles coloured by activation (blue 0 .. red 1), ground reaction arrows at the centre of\n"
     "pressure (1 m per body weight), knee contact arrows (0.25 m per body weight).\n\n"
@@ -189,7 +190,13 @@ int gs_cmd_render(int argc, char** argv) {
   }
 
   // model and motion: everything is read and checked before any output is opened
-  const char* mpath = bare_model ? input : (model_path ? model_path : GS_DEFAULT_MODEL);
+  // a solution folder is drawn with the model it was solved with (its summary.json)
+  char solved_with[4096];
+  const char* mpath = bare_model ? input
+                      : model_path ? model_path
+                      : gs_app_solution_model(input, solved_with, (int)sizeof(solved_with))
+                          ? solved_with
+                          : GS_DEFAULT_MODEL;
   char err[1024];
   mjModel* m = gs_model_load(mpath, err, sizeof(err));
   if (!m) {

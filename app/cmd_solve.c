@@ -36,7 +36,8 @@ static const char* kTrackUsage =
     "variables.sto (every node variable: the exact restart) and summary.json (with the peak\n"
     "knee contact forces). Exit status 3 when the solver stopped short (its best iterate,\n"
     "polished, is written).\n\n"
-    "  --model FILE        MJCF model (default: mjmodels/jw_fullbody.xml)\n"
+    "  --model FILE        MJCF model (default: mjmodels/jw_fullbody_knee6.xml, the six-DOF\n"
+    "                      implant knee; mjmodels/jw_fullbody.xml has the placeholder knee)\n"
     "  --nodes N           collocation nodes (default 80)\n"
     "  --init DIR          start from the solution in DIR: its variables.sto on the same nodes,\n"
     "                      or refined from fewer (N - 1 a multiple, e.g. 20 -> 39 -> 77, defects\n"
@@ -829,7 +830,8 @@ static const char* kPredictUsage =
     "TRACK_DIR (its forward progression rescaled to V). Writes the files of `gaitsim track`;\n"
     "summary.json adds stride time and length, their change from the guess, the cost of\n"
     "transport and peak triceps surae excitations. Exit status 3 when the solver stopped short.\n\n"
-    "  --model FILE        MJCF model (default: mjmodels/jw_fullbody.xml)\n"
+    "  --model FILE        MJCF model (default: the one TRACK_DIR/summary.json names, else\n"
+    "                      mjmodels/jw_fullbody_knee6.xml)\n"
     "  --nodes N           collocation nodes (default 20)\n"
     "  --threads N         worker threads (default 2)\n"
     "  --max-iter N        Ipopt iteration limit (default 1000)\n"
@@ -861,7 +863,7 @@ int gs_cmd_predict(int argc, char** argv) {
   o.w_accel = PREDICT_W_ACCEL;
   o.fibre_bounds = 1;
   optind = 1;
-  int c, bad = 0;
+  int c, bad = 0, model_given = 0;
   char err[256], *end;
   while ((c = getopt_long(argc, argv, "g:s:o:m:n:t:i:T:w:PFp:h", options, NULL)) != -1) {
     switch (c) {
@@ -871,7 +873,10 @@ int gs_cmd_predict(int argc, char** argv) {
         bad |= *end || end == optarg || !(o.speed > 0 && o.speed < 10);
         break;
       case 'o': o.out = optarg; break;
-      case 'm': o.model = optarg; break;
+      case 'm':
+        o.model = optarg;
+        model_given = 1;
+        break;
       case 'n': bad |= parse_int(optarg, 3, &o.nodes); break;
       case 't': bad |= parse_int(optarg, 1, &o.threads) || o.threads > 64; break;
       case 'i': bad |= parse_int(optarg, 0, &o.max_iter); break;
@@ -897,6 +902,10 @@ int gs_cmd_predict(int argc, char** argv) {
     return GS_EXIT_USAGE;
   }
   o.trial = o.guess;
+  // the guess's own model unless --model: a solution continues on the model it was solved with
+  static char guess_model[4096];
+  if (!model_given && gs_app_solution_model(o.guess, guess_model, (int)sizeof(guess_model)))
+    o.model = guess_model;
   return solve(o);
 }
 

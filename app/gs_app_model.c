@@ -70,3 +70,21 @@ cJSON* gs_app_read_json(const char* path) {
   free(text);
   return j;
 }
+
+const char* gs_app_solution_model(const char* dir, char* buf, int n) {
+  char path[4096];
+  snprintf(path, sizeof(path), "%s/summary.json", dir);
+  cJSON* j = gs_app_read_json(path);
+  const cJSON* model = j ? cJSON_GetObjectItemCaseSensitive(j, "model") : NULL;
+  const char* found = NULL;
+  if (cJSON_IsString(model) && model->valuestring[0] &&
+      snprintf(buf, (size_t)n, "%s", model->valuestring) < n) {
+    FILE* f = fopen(buf, "rb");
+    if (f) {
+      fclose(f);
+      found = buf;
+    }
+  }
+  cJSON_Delete(j);
+  return found;
+}

@@ -23,7 +23,14 @@ int gs_app_write_table(const char* dir, const char* name, const gsTable* t);
 // frees with cJSON_Delete), or NULL when the file is missing, unreadable or not JSON.
 struct cJSON* gs_app_read_json(const char* path);
 
-// Default bundled model: GAITSIM_SOURCE_DIR/mjmodels/jw_fullbody.xml.
-#define GS_DEFAULT_MODEL GAITSIM_SOURCE_DIR "/mjmodels/jw_fullbody.xml"
+// Default bundled model: JW's full body with the six-DOF implant knee (surrogate contact and
+// ligaments, mjmodels/README.md "jw_fullbody_knee6.xml"). mjmodels/jw_fullbody.xml is the same
+// model with the placeholder knee (a spring-damper on knee_ty).
+#define GS_DEFAULT_MODEL GAITSIM_SOURCE_DIR "/mjmodels/jw_fullbody_knee6.xml"
+
+// The model a solution folder was solved with: the "model" of DIR/summary.json when that file
+// exists, copied into buf (size n). Returns buf, or NULL (no summary, no model entry, or the
+// file is gone).
+const char* gs_app_solution_model(const char* dir, char* buf, int n);
 
 #endif  // GAITSIM_APP_GS_APP_MODEL_H_

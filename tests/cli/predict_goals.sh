@@ -4,7 +4,9 @@
 # sum to the objective and objective_share to 1, the tracking goals are 0; the fibre-length
 # bounds 0.25 <= lM/lopt <= 1.5 are on by default (the guess's count outside them printed, a
 # fibre block in the violation lines) and --no-fibre-bounds removes their 93 x 5 rows; the accel
-# weight parses for track and predict, a negative one is bad usage (exit 2).
+# weight parses for track and predict, a negative one is bad usage (exit 2). Without --model,
+# predict continues on the model the guess's summary.json names (here the placeholder-knee
+# jw_fullbody.xml), else on the bundled default (jw_fullbody_knee6.xml).
 # usage: predict_goals.sh GAITSIM SOURCE_DIR
 set -u
 gaitsim=$1 src=$2
@@ -43,6 +45,18 @@ check "--no-fibre-bounds: 465 fewer constraints (${c1:-?} vs ${c2:-?})" \
 check "--no-fibre-bounds: no fibre block" bash -c "! grep -q ' fibre ' off.txt"
 check "accel=0: no acceleration goal" /usr/bin/python3 -c "import json, sys
 sys.exit(0 if json.load(open('off/summary.json'))['objective_terms']['accel'] == 0 else 1)"
+
+# the guess's model: a copy of the fixture whose summary.json names jw_fullbody.xml
+mkdir -p named
+cp "$guess"/*.sto "$guess"/*.mot named/
+/usr/bin/python3 -c "import json,sys; s=json.load(open(sys.argv[1])); s['model']=sys.argv[2]; \
+json.dump(s, open('named/summary.json','w'))" "$guess/summary.json" "$src/mjmodels/jw_fullbody.xml"
+"$gaitsim" predict --guess named --speed 0.8 --out from_named --nodes 5 --max-iter 0 --no-polish \
+  --threads 1 >/dev/null 2>&1
+check "predict continues on the guess's model" /usr/bin/python3 -c "import json,sys; \
+sys.exit(0 if json.load(open('from_named/summary.json'))['model'].endswith('/jw_fullbody.xml') else 1)"
+check "without a named model: the bundled knee6 model" /usr/bin/python3 -c "import json,sys; \
+sys.exit(0 if json.load(open('on/summary.json'))['model'].endswith('/jw_fullbody_knee6.xml') else 1)"
 
 "$gaitsim" predict --guess "$guess" --speed 0.8 --out x --weight accel=-1 >/dev/null 2>&1
 check "predict --weight accel=-1: usage, exit 2" test $? -eq 2

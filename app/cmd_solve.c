@@ -58,8 +58,10 @@ static const char* kTrackUsage =
     "                      gauss-newton (exact for the tracking squares, constraints left out)\n"
     "                      or exact (the Lagrangian's Hessian by structured finite differences)\n"
     "  --weight NAME=W     goal weight, NAME one of pelvis_rot (default 10), pelvis_trans (10),\n"
-    "                      joint (1), grf (10), effort (50), accel (0) (repeatable); each\n"
-    "                      tracking group is a mean of squared errors over 5 deg, 2 cm or 0.1 BW;\n"
+    "                      joint (1), grf (10), grm (0), effort (50), accel (0) (repeatable);\n"
+    "                      grm: the ground reaction moment about the origin (centre of pressure\n"
+    "                      x force, so the feet's placement); each tracking group is a mean of\n"
+    "                      squared errors over 5 deg, 2 cm, 0.1 BW or 0.1 BW x 0.1 m;\n"
     "                      accel: the mean over all coordinates of (qddot / 50 rad/s^2 or\n"
     "                      m/s^2)^2, a smoothness regularisation. summary.json: objective_terms\n"
     "                      (each goal's part of J) and objective_share (its fraction of J)\n"
@@ -81,6 +83,7 @@ typedef struct {
   int guess_static;    // 1: static-optimisation guess (go_gait_guess_static), 0: the trial's
   go_ipopt_opts ipopt; // solver options
   double w_pelvis_rot, w_pelvis_trans, w_joint, w_grf, w_effort;  // goal weights (-)
+  double w_grm;        // weight of the ground reaction moment (centre of pressure) goal (-)
   double w_accel;      // weight of the mean squared acceleration (qddot / 50)^2 (-)
   int fibre_bounds;    // predict: 1: 0.25 <= lM/lopt <= 1.5 path rows (go_gait_opts.fibre_bounds)
   int pqn;             // 1: partitioned quasi-Newton Hessian (go_hessian.h)
@@ -93,12 +96,13 @@ typedef struct {
 
 // --weight NAME=VALUE
 static int parse_weight(const char* arg, gsTrackOptions* o) {
-  static const char* names[] = {"pelvis_rot", "pelvis_trans", "joint", "grf", "effort", "accel"};
-  double* slots[] = {&o->w_pelvis_rot, &o->w_pelvis_trans, &o->w_joint, &o->w_grf, &o->w_effort,
-                     &o->w_accel};
+  static const char* names[] = {"pelvis_rot", "pelvis_trans", "joint", "grf",
+                                "grm",        "effort",       "accel"};
+  double* slots[] = {&o->w_pelvis_rot, &o->w_pelvis_trans, &o->w_joint, &o->w_grf,
+                     &o->w_grm,        &o->w_effort,       &o->w_accel};
   const char* eq = strchr(arg, '=');
   if (!eq) return -1;
-  for (int i = 0; i < 6; i++) {
+  for (int i = 0; i < 7; i++) {
     if (strlen(names[i]) == (size_t)(eq - arg) && strncmp(arg, names[i], (size_t)(eq - arg)) == 0) {
       char* end;
       double v = strtod(eq + 1, &end);
@@ -141,6 +145,8 @@ static void defaults(gsTrackOptions* o) {
   for (size_t i = 0; i < sizeof(stop_rule) / sizeof(stop_rule[0]); i++)
     go_ipopt_opts_set(&o->ipopt, stop_rule[i][0], stop_rule[i][1], err, sizeof(err));
   o->w_pelvis_rot = o->w_pelvis_trans = o->w_grf = 10.0;
+  o->w_grm = 0.0;      // off: 10 narrows the stance to the measured one but, at 600 iterations,
+                       // worsens pelvis, GRF and knee tracking (docs/BENCHMARKS.md, 2026-12-02)
   o->w_joint = 1.0;
   o->w_effort = 50.0;  // 0.1 left mean activation at 0.37 (co-contraction); issue #6 note
   o->w_accel = 0.0;    // tracking: none (results stay as they were); predict: PREDICT_W_ACCEL
@@ -285,7 +291,7 @@ static void variable_name(const go_gait* g, int j, char* buf, size_t n) {
       {L->x_q, nv, "q", 0},      {L->x_qd, nv, "qdot", 0},   {L->x_a, na, "a", 1},
       {L->x_ft, ne, "fT", 2},    {L->xd_q, nv, "dq", 0},     {L->xd_qdd, nv, "qddot", 0},
       {L->xd_a, na, "adot", 1},  {L->xd_ft, ne, "dfT", 2},   {L->u_e, na, "e", 1},
-      {L->u_grf, GO_GAIT_NGRF, "grf", 3}};
+      {L->u_grf, L->ngrf, "grf", 3}};
   for (size_t b = 0; b < sizeof(blocks) / sizeof(blocks[0]); b++) {
     if (j < blocks[b].off || j >= blocks[b].off + blocks[b].count) continue;
     kind = blocks[b].kind;
@@ -295,7 +301,8 @@ static void variable_name(const go_gait* g, int j, char* buf, size_t n) {
       case 1: dof = mj_id2name(m, mjOBJ_ACTUATOR, idx); break;
       case 2: dof = mj_id2name(m, mjOBJ_ACTUATOR, L->elastic[idx]); break;
       default: {
-        static const char* grf[GO_GAIT_NGRF] = {"r_x", "r_y", "r_z", "l_x", "l_y", "l_z"};
+        static const char* grf[GO_GAIT_NGRF] = {"r_x",  "r_y",  "r_z",  "l_x",  "l_y",  "l_z",
+                                                "r_mx", "r_my", "r_mz", "l_mx", "l_my", "l_mz"};
         dof = grf[idx];
       }
     }
@@ -437,8 +444,9 @@ static int write_solution(go_gait* g, const double* z, const char* out, const do
     fprintf(stderr, "gaitsim: track: %s\n", err);
     goto done;
   }
-  // sums of squares: pelvis rot, pelvis trans, joint rot, grf ap, v, ml; counts
-  double ss[7] = {0}, cnt[7] = {0};
+  // sums of squares: pelvis rot, pelvis trans, joint rot, grf ap, v, ml, knee contact, centre
+  // of pressure fore-aft and mediolateral; counts
+  double ss[9] = {0}, cnt[9] = {0};
   double peak_r = -INFINITY, peak_l = -INFINITY;  // largest total contact, right and left (N)
   for (int k = 0; k < N; k++) {
     const double* zk = z + (size_t)k * L->nz;
@@ -490,12 +498,24 @@ static int write_solution(go_gait* g, const double* z, const char* out, const do
         ss[3 + c] += sq((fg.force[comp[c]] - ref) / bw);
         cnt[3 + c]++;
       }
+      // centre of pressure where the measured foot carries > 0.1 BW and the model's is loaded:
+      // the measured one from the moment reference about the origin (x = -M_y / F_z, y = M_x /
+      // F_z on the floor)
+      double fz = go_gait_grf_ref(g, k, 3 * s + 2);
+      double mx = go_gait_grf_ref(g, k, GO_GAIT_GRM_OFFSET + 3 * s);
+      double my = go_gait_grf_ref(g, k, GO_GAIT_GRM_OFFSET + 3 * s + 1);
+      if (fz > 0.1 * bw && isfinite(mx) && isfinite(my) && fg.loaded) {
+        ss[7] += sq(100 * (fg.cop[0] + my / fz));
+        ss[8] += sq(100 * (fg.cop[1] - mx / fz));
+        cnt[7]++, cnt[8]++;
+      }
     }
   }
-  static const char* keys[7] = {"pelvis_rot_deg", "pelvis_trans_cm", "joint_rot_deg",
-                                "grf_ap_bw", "grf_v_bw", "grf_ml_bw", "knee_contact_bw"};
+  static const char* keys[9] = {"pelvis_rot_deg", "pelvis_trans_cm", "joint_rot_deg",
+                                "grf_ap_bw",      "grf_v_bw",        "grf_ml_bw",
+                                "knee_contact_bw", "cop_ap_cm",      "cop_ml_cm"};
   cJSON* rms = cJSON_AddObjectToObject(summary, "rms");
-  for (int q = 0; q < 7; q++) {
+  for (int q = 0; q < 9; q++) {
     if (cnt[q] > 0) cJSON_AddNumberToObject(rms, keys[q], sqrt(ss[q] / cnt[q]));
     else cJSON_AddNullToObject(rms, keys[q]);
   }
@@ -966,6 +986,7 @@ static int solve(gsTrackOptions o) {
     go.w_pelvis_trans = o.w_pelvis_trans;
     go.w_joint = o.w_joint;
     go.w_grf = o.w_grf;
+    go.w_grm = o.w_grm;
   } else if (predict_setup(m, &o, &go, &band, &T0, &dx0) != 0) {
     goto done;
   }

@@ -66,9 +66,9 @@ struct go_gait {
   double* bnd_scale;          // (n_bnd)
   double speed;               // speed constraint (m/s), 0: none
   double* q_ref;              // measured coordinates (N x nv), NAN when absent
-  double* grf_ref;            // measured grf, world (N x 6), NAN when absent
+  double* grf_ref;            // measured grf, world (N x GO_GAIT_NGRF), NAN when absent
   double* q_wt;               // tracking weight / scale^2 / count per dof (nv)
-  double w_grf;               // grf weight / scale^2 / 6
+  double grf_wt[GO_GAIT_NGRF]; // per grf component: its goal weight / scale^2 / GO_GAIT_NGRF
   double w_effort;            // effort weight / na
   double w_accel;             // acceleration weight / GO_GAIT_ACCEL_SCALE^2 / nv  (s^4, s^4/m^2)
   double* path_lb;            // path row bounds, physical (n_path): 0, fibre rows fibre_lo
@@ -100,6 +100,7 @@ void go_gait_opts_default(go_gait_opts* o) {
   o->w_pelvis_trans = 1.0;
   o->w_joint = 1.0;
   o->w_grf = 1.0;
+  o->w_grm = 0.0;
   o->w_effort = 0.1;
   o->periodic = 1;
   o->fibre_lo = 0.25;
@@ -210,6 +211,10 @@ int go_gait_path_eval(const go_gait* g, mjData* d, const double* z, double* res)
     gs_physics_foot_grf(m, d, s == 0 ? 'r' : 'l', 5.0, &fg);
     for (int c = 0; c < 3; c++) {
       res[L->r_grf + 3 * s + c] = z[L->u_grf + 3 * s + c] - fg.force[c];
+      if (L->ngrf > GO_GAIT_GRM_OFFSET) {
+        res[L->r_grf + GO_GAIT_GRM_OFFSET + 3 * s + c] =
+            z[L->u_grf + GO_GAIT_GRM_OFFSET + 3 * s + c] - fg.moment[c];
+      }
     }
   }
   // normalised fibre lengths (bounded by path_lb, path_ub)
@@ -418,10 +423,10 @@ static int integrand_cb(void* vctx, int k, const double* z, double* out) {
       s += g->q_wt[j] * err * err;
     }
   }
-  if (g->w_grf > 0) {
-    for (int c = 0; c < GO_GAIT_NGRF; c++) {
+  for (int c = 0; c < L->ngrf; c++) {
+    if (g->grf_wt[c] > 0) {
       double err = z[L->u_grf + c] - g->grf_ref[k * GO_GAIT_NGRF + c];
-      s += g->w_grf * err * err;
+      s += g->grf_wt[c] * err * err;
     }
   }
   for (int i = 0; i < L->na; i++) {
@@ -448,9 +453,9 @@ static int integrand_grad_cb(void* vctx, int k, const double* z, double* dL) {
       dL[L->x_q + j] = 2 * g->q_wt[j] * (z[L->x_q + j] - g->q_ref[k * L->nv + j]);
     }
   }
-  if (g->w_grf > 0) {
-    for (int c = 0; c < GO_GAIT_NGRF; c++) {
-      dL[L->u_grf + c] = 2 * g->w_grf * (z[L->u_grf + c] - g->grf_ref[k * GO_GAIT_NGRF + c]);
+  for (int c = 0; c < L->ngrf; c++) {
+    if (g->grf_wt[c] > 0) {
+      dL[L->u_grf + c] = 2 * g->grf_wt[c] * (z[L->u_grf + c] - g->grf_ref[k * GO_GAIT_NGRF + c]);
     }
   }
   for (int i = 0; i < L->na; i++) {
@@ -472,7 +477,7 @@ static int integrand_hess_cb(void* vctx, int k, const double* z, double* d2L) {
   }
   memset(d2L, 0, sizeof(double) * (size_t)L->nz);
   for (int j = 0; j < L->nv; j++) d2L[L->x_q + j] = 2 * g->q_wt[j];
-  for (int c = 0; c < GO_GAIT_NGRF; c++) d2L[L->u_grf + c] = 2 * g->w_grf;
+  for (int c = 0; c < L->ngrf; c++) d2L[L->u_grf + c] = 2 * g->grf_wt[c];
   for (int i = 0; i < L->na; i++) d2L[L->u_e + i] = 2 * g->w_effort;
   for (int j = 0; j < L->nv; j++) d2L[L->xd_qdd + j] = 2 * g->w_accel;
   return 0;
@@ -570,6 +575,8 @@ static int pattern(const go_gait* g, int* col_ptr, int* row_idx) {
       for (int s = 0; s < 2; s++) {
         if (g->foot[s * nv + j]) {
           for (int c = 0; c < 3; c++) PUT(L->r_grf + 3 * s + c);
+          for (int c = 0; L->ngrf > GO_GAIT_GRM_OFFSET && c < 3; c++)
+            PUT(L->r_grf + GO_GAIT_GRM_OFFSET + 3 * s + c);
         }
       }
       for (int i = 0; L->r_fib >= 0 && col < L->x_qd && i < L->na; i++) {
@@ -656,7 +663,7 @@ void go_gait_free(go_gait* g) {
 static int build_elements(go_gait* g) {
   const go_gait_layout* L = &g->L;
   int nv = L->nv, na = L->na, ne = L->ne, E = 1 + ne + na;
-  int nrows = 2 * nv + 2 * 0 + nv + GO_GAIT_NGRF + ne + 2 * na;  // generous
+  int nrows = 2 * nv + 2 * 0 + nv + L->ngrf + ne + 2 * na;  // generous
   int nvars = (3 * nv + na + ne) + ne * (2 * nv + 3) + 2 * na;
   int* mem = (int*)malloc(sizeof(int) * (size_t)(2 * (E + 1) + nrows + nvars));
   if (!mem) return -1;
@@ -665,7 +672,7 @@ static int build_elements(go_gait* g) {
   // dynamics
   row_ptr[0] = var_ptr[0] = 0;
   for (int j = 0; j < nv; j++) rows[nr++] = L->r_eom + j;
-  for (int c = 0; c < GO_GAIT_NGRF; c++) rows[nr++] = L->r_grf + c;
+  for (int c = 0; c < L->ngrf; c++) rows[nr++] = L->r_grf + c;
   for (int i = 0; L->r_fib >= 0 && i < na; i++)
     if (L->elastic_of[i] < 0) rows[nr++] = L->r_fib + i;
   for (int j = 0; j < nv; j++) vars[nvv++] = L->x_q + j;
@@ -753,9 +760,10 @@ int go_gait_objective_terms(const go_gait* g, const double* z, double* terms) {
       v[go_gait_dof_is_root(g->m, j) ? GO_GAIT_TERM_PELVIS : GO_GAIT_TERM_JOINTS] +=
           g->q_wt[j] * err * err;
     }
-    for (int c = 0; g->w_grf > 0 && c < GO_GAIT_NGRF; c++) {
+    for (int c = 0; c < L->ngrf; c++) {
+      if (!(g->grf_wt[c] > 0)) continue;
       double err = zk[L->u_grf + c] - g->grf_ref[k * GO_GAIT_NGRF + c];
-      v[GO_GAIT_TERM_GRF] += g->w_grf * err * err;
+      v[GO_GAIT_TERM_GRF] += g->grf_wt[c] * err * err;
     }
     for (int i = 0; i < L->na; i++)
       v[GO_GAIT_TERM_EFFORT] += g->w_effort * zk[L->u_e + i] * zk[L->u_e + i];
@@ -813,24 +821,33 @@ static int references(go_gait* g, const go_gait_opts* o, const int* qcol, char* 
     }
   }
   if (status == 0 && o->grf) {
-    static const char* names[GO_GAIT_NGRF] = {"ground_force_r_vx", "ground_force_r_vy",
-                                              "ground_force_r_vz", "ground_force_l_vx",
-                                              "ground_force_l_vy", "ground_force_l_vz"};
+    // per foot: force (3), centre of pressure (3), torque at the COP (3); OpenSim frame
+    enum { kCols = 18 };
+    static const char* names[kCols] = {
+        "ground_force_r_vx", "ground_force_r_vy", "ground_force_r_vz", "ground_force_r_px",
+        "ground_force_r_py", "ground_force_r_pz", "ground_torque_r_x", "ground_torque_r_y",
+        "ground_torque_r_z", "ground_force_l_vx", "ground_force_l_vy", "ground_force_l_vz",
+        "ground_force_l_px", "ground_force_l_py", "ground_force_l_pz", "ground_torque_l_x",
+        "ground_torque_l_y", "ground_torque_l_z"};
     gsTable sel;
     gs_table_init(&sel);
     double t0 = o->grf->time[0];
     for (int k = 0; k < N; k++) times[k] = t0 + g->T * k / (N - 1);
-    if (gs_table_select(o->grf, names, GO_GAIT_NGRF, &sel, err, errsz) != 0 ||
+    if (gs_table_select(o->grf, names, kCols, &sel, err, errsz) != 0 ||
         gs_table_resample(&sel, times, N, &rs, err, errsz) != 0) {
       status = -1;
     }
     for (int k = 0; status == 0 && k < N; k++) {
       for (int s = 0; s < 2; s++) {  // OpenSim (x, y up, z) -> world (x, -z, y)
-        const double* v = rs.data + k * GO_GAIT_NGRF + 3 * s;
-        double* w = g->grf_ref + k * GO_GAIT_NGRF + 3 * s;
-        w[0] = v[0];
-        w[1] = -v[2];
-        w[2] = v[1];
+        const double* v = rs.data + k * kCols + 9 * s;
+        double f[3] = {v[0], -v[2], v[1]}, p[3] = {v[3], -v[5], v[4]}, tq[3] = {v[6], -v[8], v[7]};
+        double* w = g->grf_ref + k * GO_GAIT_NGRF;
+        double mom[3];
+        mju_cross(mom, p, f);  // moment about the world origin: p x F + torque at the COP
+        for (int c = 0; c < 3; c++) {
+          w[3 * s + c] = f[c];
+          w[GO_GAIT_GRM_OFFSET + 3 * s + c] = mom[c] + tq[c];
+        }
       }
     }
     gs_table_free(&sel);
@@ -918,8 +935,9 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
     if (g->mprm[i].elastic) g->elastic[ne++] = i;
   }
 
-  // layout
+  // layout: the ground reaction moments are variables (and rows) only when tracked
   go_gait_layout* L = &g->L;
+  L->ngrf = o->grf && o->w_grm > 0 ? GO_GAIT_NGRF : GO_GAIT_GRM_OFFSET;
   L->nv = nv;
   L->na = na;
   L->ne = ne;
@@ -934,13 +952,13 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   L->xd_ft = L->nx + 2 * nv + na;
   L->u_e = 2 * L->nx;
   L->u_grf = 2 * L->nx + na;
-  L->nz = 2 * L->nx + na + GO_GAIT_NGRF;
+  L->nz = 2 * L->nx + na + L->ngrf;
   L->r_link = 0;
   L->r_eom = nv;
   L->r_hill = 2 * nv;
   L->r_act = 2 * nv + ne;
   L->r_grf = 2 * nv + ne + na;
-  L->n_path = 2 * nv + ne + na + GO_GAIT_NGRF;
+  L->n_path = 2 * nv + ne + na + L->ngrf;
   L->r_fib = -1;
   if (o->fibre_bounds) {
     if (!(o->fibre_lo >= 0 && o->fibre_hi > o->fibre_lo)) {
@@ -1017,7 +1035,12 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
     g->q_wt[j] = w / (sc * sc) / count[grp];
   }
   double grf_sc = TR_GRF * g->weight;
-  g->w_grf = o->grf ? o->w_grf / (grf_sc * grf_sc) / GO_GAIT_NGRF : 0;
+  double grm_sc = grf_sc * GO_GAIT_GRM_LENGTH;
+  for (int c = 0; c < GO_GAIT_NGRF; c++) {
+    int moment = c >= GO_GAIT_GRM_OFFSET;
+    double w = moment ? o->w_grm : o->w_grf, sc = moment ? grm_sc : grf_sc;
+    g->grf_wt[c] = o->grf && w > 0 && c < g->L.ngrf ? w / (sc * sc) / g->L.ngrf : 0;
+  }
   g->w_effort = o->w_effort / na;
   g->w_accel = o->w_accel > 0 ? o->w_accel / (GO_GAIT_ACCEL_SCALE * GO_GAIT_ACCEL_SCALE) / nv : 0;
   g->ivars = (int*)zalloc((size_t)nz, sizeof(int));
@@ -1032,8 +1055,8 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
     for (int e = 0; e < L->ne; e++) g->ivars[g->n_ivars++] = L->x_ft + e;
   }
   for (int i = 0; i < na; i++) g->ivars[g->n_ivars++] = L->u_e + i;
-  if (g->w_grf > 0) {
-    for (int c = 0; c < GO_GAIT_NGRF; c++) g->ivars[g->n_ivars++] = L->u_grf + c;
+  for (int c = 0; c < L->ngrf; c++) {
+    if (g->grf_wt[c] > 0) g->ivars[g->n_ivars++] = L->u_grf + c;
   }
   if (g->w_accel > 0) {
     for (int j = 0; j < nv; j++) g->ivars[g->n_ivars++] = L->xd_qdd + j;
@@ -1089,7 +1112,7 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
     g->z_ub[L->xd_ft + e] = 1000;
     g->z_scale[L->xd_ft + e] = SC_FTDOT;
   }
-  for (int c = 0; c < GO_GAIT_NGRF; c++) {
+  for (int c = 0; c < L->ngrf; c++) {  // forces: m g; moments: m g x 1 m
     g->z_lb[L->u_grf + c] = -10 * g->weight;
     g->z_ub[L->u_grf + c] = 10 * g->weight;
     g->z_scale[L->u_grf + c] = g->weight;
@@ -1101,7 +1124,7 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   }
   for (int e = 0; e < ne; e++) g->path_scale[L->r_hill + e] = 1;
   for (int i = 0; i < na; i++) g->path_scale[L->r_act + i] = SC_ADOT;
-  for (int c = 0; c < GO_GAIT_NGRF; c++) g->path_scale[L->r_grf + c] = g->weight;
+  for (int c = 0; c < L->ngrf; c++) g->path_scale[L->r_grf + c] = g->weight;
   g->path_lb = (double*)zalloc((size_t)L->n_path, sizeof(double));
   g->path_ub = (double*)zalloc((size_t)L->n_path, sizeof(double));
   for (int i = 0; L->r_fib >= 0 && i < na; i++) {
@@ -1186,7 +1209,7 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   // the NLP
   go_problem p;
   memset(&p, 0, sizeof(p));
-  p.dims = (go_dims){g->N, L->nx, na + GO_GAIT_NGRF, L->n_path, g->n_bnd, g->free_time};
+  p.dims = (go_dims){g->N, L->nx, na + L->ngrf, L->n_path, g->n_bnd, g->free_time};
   p.z_lb = g->z_lb;
   p.z_ub = g->z_ub;
   p.T = g->T;

@@ -6,14 +6,16 @@
 //                                                       normalised tendon forces of the ne
 //                                                       elastic-tendon muscles
 //   xdot = [q' (nv) | qddot (nv) | adot (na) | fT' (ne)]
-//   u    = [e (na) | grf (6)]                           excitations; ground reaction force of the
-//                                                       right then left foot, world frame (N)
+//   u    = [e (na) | grf (6 or 12)]                     excitations; ground reaction of the right
+//                                                       then left foot, world frame: forces (N, 6)
+//                                                       then, with w_grm > 0, moments about the
+//                                                       world origin (N m, 6)
 // The engine's state derivative of q is a separate variable q' from the state qdot: path rows
 // qdot - q' = 0 tie them (linear, analytic -1 column; the qdot column is finite-differenced with
 // the others and is exact since the row is linear). We chose these rows over a deriv_idx map in
 // the engine because the engine is done and tested; they cost nv rows and 2 nv nonzeros per node.
 //
-// Path rows per node, [link (nv) | eom (nv) | hill (ne) | act (na) | grf (6) | fibre (na)?]:
+// Path rows per node, [link (nv) | eom (nv) | hill (ne) | act (na) | grf (6|12) | fibre (na)?]:
 //   link  qdot - q'                                                        (rad/s, m/s)
 //   eom   mj_inverse(q, qdot, qddot).qfrc_inverse + actuator_moment^T tension    (N m, N)
 //         (qfrc_inverse runs mjcb_passive: the foot contact; all nv rows, pelvis included: no
@@ -22,6 +24,9 @@
 //   hill  gs_muscle_equilibrium_residual(a, lMT, vMT, fT, fT') for each elastic muscle     (-)
 //   act   adot - gs_activation_dot(e, a)                                             (1/s)
 //   grf   grf - gs_physics_foot_grf(q, qdot).force, per foot                           (N)
+//         then grf moment - gs_physics_foot_grf(q, qdot).moment (about the world origin:
+//         r_cop x F + free moment; tracking it is tracking the centre of pressure weighted by
+//         the force, and so the feet's placement)                                     (N m)
 //   fibre (only with opts.fibre_bounds) fibre_lo <= lM / lopt <= fibre_hi for every muscle,
 //         default 0.25 and 1.5 (Lin, Walter & Pandy 2018, eq. 2's bounds on the normalised fibre
 //         length): lM = gs_muscle_fibre_length(lMT(q), lT) with lT = lts
@@ -43,12 +48,15 @@
 // its fT column.
 //
 // Scaling (Ipopt sees O(1)): q 1, qdot and q' 5, qddot 50, a and e 1, adot 20, fT 1, fT' 10,
-// grf m g; rows: link 5, eom m g * 1 m (N m; N for slides), hill 1, act 20, grf m g; periodicity
+// grf m g (forces) and m g * 1 m (moments); rows: link 5, eom m g * 1 m (N m; N for slides), hill 1,
+// act 20, grf as their variables; periodicity
 // fibre 1 (lM / lopt is O(1)); rows as their variable, speed row 1 m/s; objective 1.
 //
 // Objective J = I / T, I = trapezoidal integral of (means over each group of terms)
 //   w_pelvis_rot ((q - q_meas)/5 deg)^2 + w_pelvis_trans ((q - q_meas)/2 cm)^2
 //   + w_joint ((q - q_meas)/(5 deg or 2 cm))^2 + w_grf ((grf - grf_meas)/(0.1 m g))^2
+//   + w_grm ((M - M_meas)/(0.1 m g x GO_GAIT_GRM_LENGTH))^2   (the "grf" goal; the mean over
+//     its 6 force and 6 moment components)
 //   + w_effort e^2 + w_accel (qddot / GO_GAIT_ACCEL_SCALE)^2
 // over the coordinates present in the measured table (pelvis: the dofs of the root body; accel:
 // every dof), with an analytic gradient and the exact diagonal Hessian (integrand_hess, for the
@@ -61,7 +69,7 @@
 // and of the excitations; optionally mean speed (tx_last - tx_first) / T = speed.
 // Bounds: a, e in [0.001, 1]; fT in [0, 5]; q within joint ranges (limited joints), root dofs
 // within the measured range +- 0.5 rad / 0.5 m, others +-pi; qdot, q' +-20; qddot +-500;
-// adot +-1000; fT' +-1000; grf +-10 m g.
+// adot +-1000; fT' +-1000; grf +-10 m g (forces), +-10 m g x 1 m (moments).
 //
 // Threads: one mjData (the model's nuserdata) per engine worker; results are bitwise identical
 // for any number of threads (the engine's rule).
@@ -74,7 +82,13 @@
 #include "optim/go_collocation.h"
 #include "optim/go_hessian.h"
 
-#define GO_GAIT_NGRF 6  // grf variables per node: right foot x y z, left foot x y z (world)
+#define GO_GAIT_NGRF 12  // most grf variables per node (layout ngrf): force right x y z, left
+                         // x y z (world, N), then moment about the world origin right x y z,
+                         // left x y z (N m); go_gait_grf_ref has all 12
+#define GO_GAIT_GRM_OFFSET 6     // first moment among the grf variables
+#define GO_GAIT_GRM_LENGTH 0.1   // lever of the moment goal's scale (m): a moment error of
+                                 // 0.1 m g x 0.1 m (a 1 cm centre-of-pressure error at 1 BW)
+                                 // weighs as a force error of 0.1 m g
 #define GO_GAIT_ACCEL_SCALE 50.0  // s_j of the acceleration goal (rad/s^2, m/s^2): qddot's scale
 
 // goals of J (go_gait_objective_terms), in this order; names in GO_GAIT_TERM_NAMES
@@ -93,7 +107,9 @@ typedef struct {
   double w_pelvis_rot;              // weight of pelvis rotation tracking                 (-)
   double w_pelvis_trans;            // weight of pelvis translation tracking              (-)
   double w_joint;                   // weight of the other coordinates                    (-)
-  double w_grf;                     // weight of ground reaction tracking                 (-)
+  double w_grf;                     // weight of ground reaction force tracking           (-)
+  double w_grm;                     // weight of ground reaction moment tracking (about the
+                                    // world origin: centre of pressure x force)          (-)
   double w_effort;                  // weight of the mean squared excitation              (-)
   double w_accel;                   // weight of the mean over all nv dofs of
                                     // (qddot_j / GO_GAIT_ACCEL_SCALE)^2; 0: none         (-)
@@ -120,11 +136,13 @@ typedef struct {
   int na;        // muscles (activations, excitations)
   int ne;        // elastic-tendon muscles
   int nx;        // states, 2 nv + na + ne
-  int nz;        // node variables, 2 nx + na + GO_GAIT_NGRF
-  int n_path;    // path rows, 2 nv + ne + na + GO_GAIT_NGRF (+ na with fibre bounds)
+  int nz;        // node variables, 2 nx + na + ngrf
+  int n_path;    // path rows, 2 nv + ne + na + ngrf (+ na with fibre bounds)
   int x_q, x_qd, x_a, x_ft;        // offsets of q, qdot, a, fT in z_k
   int xd_q, xd_qdd, xd_a, xd_ft;   // offsets of q', qddot, adot, fT'
   int u_e, u_grf;                  // offsets of excitations and grf variables
+  int ngrf;                        // grf variables (and rows): GO_GAIT_GRM_OFFSET (forces) or,
+                                   // with w_grm > 0, GO_GAIT_NGRF (forces and moments)
   int r_link, r_eom, r_hill, r_act, r_grf;  // offsets of the path row blocks
   int r_fib;                       // offset of the fibre rows (na), -1 without fibre bounds
   const int* elastic;              // actuator of elastic muscle e (ne)
@@ -135,6 +153,7 @@ typedef struct {
 typedef struct go_gait go_gait;
 
 // defaults: N 40, 1 thread, T from coords, w_pelvis_rot 1, w_pelvis_trans 1, w_joint 1, w_grf 1,
+// w_grm 0,
 // w_effort 0.1, w_accel 0, periodic 1, no free coordinates, no speed constraint; no prediction
 // (w_cot 0, fixed time, no band, no fibre bounds; fibre_lo 0.25, fibre_hi 1.5)
 void go_gait_opts_default(go_gait_opts* opts);

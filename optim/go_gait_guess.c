@@ -98,6 +98,7 @@ int go_gait_guess_from_trial(const go_gait* g, const gsTable* coords, double act
       gs_physics_foot_grf(m, d, s == 0 ? 'r' : 'l', 5.0, &fg);
       for (int c = 0; c < 3; c++) {
         zk[L->u_grf + 3 * s + c] = fg.force[c];
+        if (L->ngrf > GO_GAIT_GRM_OFFSET) zk[L->u_grf + GO_GAIT_GRM_OFFSET + 3 * s + c] = fg.moment[c];
       }
     }
   }
@@ -130,7 +131,10 @@ static void node_grf(const mjModel* m, const go_gait_layout* L, mjData* d, doubl
   for (int s = 0; s < 2; s++) {
     gsFootGrf fg;
     gs_physics_foot_grf(m, d, s == 0 ? 'r' : 'l', 5.0, &fg);
-    for (int c = 0; c < 3; c++) zk[L->u_grf + 3 * s + c] = fg.force[c];
+    for (int c = 0; c < 3; c++) {
+      zk[L->u_grf + 3 * s + c] = fg.force[c];
+      if (L->ngrf > GO_GAIT_GRM_OFFSET) zk[L->u_grf + GO_GAIT_GRM_OFFSET + 3 * s + c] = fg.moment[c];
+    }
   }
 }
 

@@ -103,6 +103,9 @@ TABLE1 = [
     ("grf_ml_bw", "GRF mediolateral", "BW", "0.02"),
     ("joint_rot_deg", "Joint rotations", "deg", "1.98"),
     ("knee_contact_bw", "Knee contact force", "BW", "0.32"),
+    # not in the paper's table: where the feet push (both feet, nodes with > 0.1 BW measured)
+    ("cop_ap_cm", "Centre of pressure fore-aft", "cm", "-"),
+    ("cop_ml_cm", "Centre of pressure mediolateral", "cm", "-"),
 ]
 
 

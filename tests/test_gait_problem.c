@@ -3,7 +3,9 @@
 // activation partials; finite differences for q, qdot) against dense central differences of the
 // whole constraint vector, every nonzero inside the declared pattern, the objective gradient,
 // bitwise equality with 1 and 2 threads, and the guess satisfying its exact rows. The problem
-// checked carries the predictive extras too: the acceleration goal (w_accel 2) and the fibre
+// checked carries the predictive extras too: the acceleration goal (w_accel 2), the ground
+// reaction moment goal (w_grm 1.5; its reference's centre of pressure against the measured one)
+// and the fibre
 // rows 0.25 <= lM/lopt <= 1.5 (their q and fT columns inside the pattern, FD agreement); the
 // Gauss-Newton Hessian diagonal against differences of the gradient; the objective's goals
 // (go_gait_objective_terms) summing to J; the fibre rows equal to the muscle model's own fibre
@@ -30,6 +32,7 @@ static double now(void) {
 }
 
 #define W_ACCEL 2.0
+#define W_GRM 1.5
 
 // extras: the acceleration goal and the fibre-length rows
 static go_gait* make(const mjModel* m, const gsTable* coords, const gsTable* grf, int nthreads,
@@ -38,6 +41,7 @@ static go_gait* make(const mjModel* m, const gsTable* coords, const gsTable* grf
   go_gait_opts_default(&o);
   o.N = 4;
   o.w_accel = extras ? W_ACCEL : 0;
+  o.w_grm = extras ? W_GRM : 0;
   o.fibre_bounds = extras;
   o.nthreads = nthreads;
   o.coords = coords;
@@ -70,18 +74,25 @@ int main(void) {
   // the fibre rows: na more rows per node, after the grf rows, nonzero only in q columns and
   // the muscle's own fT column (which every elastic muscle's row has)
   {
-    int n0, m0, ne0, bad_col = 0, ft_cols = 0, fib_nnz = 0;
+    int n0, m0, ne0, bad_col = 0, ft_cols = 0, fib_nnz = 0, grm_nnz = 0;
     go_nlp_sizes(go_gait_nlp(g0), &n0, &m0, &ne0);
+    // g1 also tracks the ground reaction moments: 6 more variables and rows per node
+    int dgrf = GO_GAIT_NGRF - GO_GAIT_GRM_OFFSET;
+    EXPECT_EQ_INT(GO_GAIT_GRM_OFFSET, L0->ngrf);
+    EXPECT_EQ_INT(GO_GAIT_NGRF, L->ngrf);
     EXPECT_EQ_INT(-1, L0->r_fib);
-    EXPECT_EQ_INT(L0->n_path, L->r_fib);
-    EXPECT_EQ_INT(L0->n_path + L->na, L->n_path);
-    EXPECT_EQ_INT(n0, n);
-    EXPECT_EQ_INT(m0 + 4 * L->na, mm);
+    EXPECT_EQ_INT(L0->n_path + dgrf, L->r_fib);
+    EXPECT_EQ_INT(L0->n_path + dgrf + L->na, L->n_path);
+    EXPECT_EQ_INT(n0 + 4 * dgrf, n);
+    EXPECT_EQ_INT(m0 + 4 * (L->na + dgrf), mm);
     int* ir0 = malloc(sizeof(int) * (size_t)ne);
     int* jc0 = malloc(sizeof(int) * (size_t)ne);
     go_nlp_jac_structure(a, ir0, jc0);
     for (int e = 0; e < ne; e++) {
       int row = ir0[e] - go_nlp_row_path(a, 0, 0);
+      if (row >= 0 && row < 4 * L->n_path && row % L->n_path >= L->r_grf + GO_GAIT_GRM_OFFSET &&
+          row % L->n_path < L->r_grf + L->ngrf)
+        grm_nnz++;  // same pattern as the force rows: q, qdot on the path to the foot, own var
       if (row < 0 || row >= 4 * L->n_path || row % L->n_path < L->r_fib) continue;
       int i = row % L->n_path - L->r_fib, v = jc0[e] % L->nz;
       fib_nnz++;
@@ -90,7 +101,8 @@ int main(void) {
     }
     EXPECT_EQ_INT(0, bad_col);
     EXPECT_EQ_INT(4 * L->ne, ft_cols);
-    EXPECT_EQ_INT(ne0 + fib_nnz, ne);
+    EXPECT_EQ_INT(ne0 + fib_nnz + grm_nnz, ne);
+    EXPECT_TRUE(grm_nnz > 0);
     printf("fibre rows: %d muscles (%d elastic), %d nonzeros per node\n", L->na, L->ne,
            fib_nnz / 4);
     free(ir0);
@@ -111,12 +123,31 @@ int main(void) {
   double link = 0, grfr = 0, act = 0;
   for (int k = 0; k < 4; k++) {
     for (int j = 0; j < L->nv; j++) link = fmax(link, fabs(g[go_nlp_row_path(a, k, L->r_link + j)]));
-    for (int c = 0; c < 6; c++) grfr = fmax(grfr, fabs(g[go_nlp_row_path(a, k, L->r_grf + c)]));
+    for (int c = 0; c < L->ngrf; c++)
+      grfr = fmax(grfr, fabs(g[go_nlp_row_path(a, k, L->r_grf + c)]));
     for (int i = 0; i < L->na; i++) act = fmax(act, fabs(g[go_nlp_row_path(a, k, L->r_act + i)]));
   }
   EXPECT_NEAR(0, link, 1e-12);
   EXPECT_NEAR(0, grfr, 1e-12);
   EXPECT_NEAR(0, act, 1e-12);
+  // the moment reference about the world origin gives back the measured centre of pressure on
+  // the floor (z = 0): x = -M_y / F_z, y = M_x / F_z (world; OpenSim px and -pz) where loaded
+  {
+    int px = gs_table_column(&grf, "ground_force_r_px"), pz = gs_table_column(&grf, "ground_force_r_pz");
+    double T = coords.time[coords.nrow - 1] - coords.time[0], worst = 0;
+    int loaded = 0;
+    for (int k = 0; k < 4; k++) {
+      double fz = go_gait_grf_ref(g1, k, 2), mx = go_gait_grf_ref(g1, k, GO_GAIT_GRM_OFFSET);
+      double my = go_gait_grf_ref(g1, k, GO_GAIT_GRM_OFFSET + 1);
+      if (!(fz > 100)) continue;
+      double t = coords.time[0] + T * k / 3.0;
+      worst = fmax(worst, fabs(-my / fz - gs_table_value_at(&grf, px, t)));
+      worst = fmax(worst, fabs(mx / fz + gs_table_value_at(&grf, pz, t)));
+      loaded++;
+    }
+    EXPECT_TRUE(px >= 0 && pz >= 0 && loaded >= 1);
+    EXPECT_NEAR(0, worst, 1e-9);  // m
+  }
   // fibre rows (scale 1) are the muscle model's own lM / lopt: elastic tendons from the fT state
   // through the forward model's fibre kinematics, rigid ones from lts
   {

@@ -120,8 +120,8 @@ CONTACT_SPHERES = [
 # foot-flat frames of the trial: both the calcaneus origin and the toes origin slower than this
 # (m/s, central differences of the IK poses)
 FOOT_FLAT_SPEED = 0.1
-# gravity (m/s^2), as the MJCF's <option gravity>
-GRAVITY = 9.81
+# standard gravity (m/s^2), written into the MJCF's <option gravity>
+GRAVITY = 9.80665
 
 EPS_ZERO = 1e-8           # |default value| below which a coordinate default counts as 0
 FD_STEP = 1e-5            # central-difference step for moment arms (rad or m)
@@ -2349,6 +2349,9 @@ class Converter:
         out.append("  Frames: body 'ground' rotates OpenSim's Y-up ground (X forward, Y up, Z right)")
         out.append("    into MuJoCo's Z-up world (+90 deg about X): OpenSim Y -> world Z,")
         out.append("    OpenSim Z -> world -Y. Coordinate values mean what they mean in OpenSim.")
+        out.append("  Contact spheres calibrated on the trial (IK_ngait_og5 foot-flat frames, the")
+        out.append("    heel strikes of mjmodels/trials/jw_ngait_og5/trial.json and the vertical")
+        out.append("    GRF of its grf.mot): mjmodels/README.md, Contact spheres and standing pose.")
         out.append("  Layout of actuator and geom user rows: callbacks/gs_model_layout.h;")
         out.append("    choices and errors: mjmodels/README.md.")
         out.append("-->")
@@ -2356,7 +2359,7 @@ class Converter:
         out.append('  <compiler angle="radian" autolimits="true" balanceinertia="true">')
         out.append('    <lengthrange useexisting="true" mode="muscle"/>')
         out.append("  </compiler>")
-        out.append('  <option timestep="0.001" gravity="0 0 -9.80665" integrator="Euler"/>')
+        out.append('  <option timestep="0.001" gravity="0 0 -%s" integrator="Euler"/>' % fmt(GRAVITY))
         out.append('  <size nuser_actuator="12" nuser_geom="6"/>')
         out.append("  <default>")
         # stiff joint limits (README "Joint limits"): a held (zero-width range) ankle must carry

@@ -1,5 +1,5 @@
 # Slow end-to-end test of the gait collocation problem (optim/go_gait.h, app/cmd_solve.c): the
-# tracking solve on jw_fullbody at 20 nodes, at most 200 Ipopt iterations. Passes when the solve
+# tracking solve on the default model (jw_fullbody_knee6) at 20 nodes, at most 200 Ipopt iterations. Passes when the solve
 # ran (exit 0 or 3 = stopped short, best iterate written), every output file exists, the summary
 # has no NaN, the feasibility polish took the best iterate (violation ~1e-3 after 200 L-BFGS
 # iterations from about 4, with the recalibrated tendon slack lengths of mjmodels/README.md) to a

@@ -21,7 +21,8 @@ coordinates.mot, grf.mot, trial.json, knee_contact.sto):
   normalised to its peak over the cycle: timing only;
 - report.md: the RMS errors of summary.json beside the paper's participant-2 values (Table 1),
   the solve facts, and links to the figures.
-Body weight: trial.json mass_kg x 9.80665 N.
+Body weight: summary.json body_weight_n (the model's mass x g, as the solve's RMS errors), else
+trial.json mass_kg x 9.80665 N.
 
 A sweep folder (`gaitsim sweep`: sweep.csv and predict_<V>/ solution folders; recognised by its
 sweep.csv, or by --track) gets figures comparing the speeds like the paper's Fig. 4-6 and 8, each
@@ -291,8 +292,11 @@ def load(args):
     mass = tj.get("mass_kg")
     if not finite_number(mass) or mass <= 0:
         raise PrepError(tj_path, "mass_kg missing or not a positive number")
-    d["bw"] = mass * G
-    d["mass"] = mass
+    # the body weight the solve normalised its RMS errors by (the model's mass x g), so that the
+    # figures and summary.json agree; the trial's mass x g for a summary without it
+    bw = summary.get("body_weight_n")
+    d["bw"] = float(bw) if finite_number(bw) and bw > 0 else mass * G
+    d["mass"] = d["bw"] / G
     scale = summary.get("grf_scale", 1.0)
     if scale is None:
         scale = 1.0
@@ -380,7 +384,7 @@ def fig_grf(d, plt):
     axes[0, 0].legend(fontsize=6, loc="best")
     scale = ("" if d["grf_scale"] == 1.0 else
              f"; measured GRF x {d['grf_scale']:.4f} (grf_scale, as tracked)")
-    fig.suptitle(f"Ground reaction forces, OpenSim frame (x forward, y up); BW = {d['mass']:g} kg x g"
+    fig.suptitle(f"Ground reaction forces, OpenSim frame (x forward, y up); BW = {d['mass']:.2f} kg x g"
                  f"{scale}", fontsize=9)
     out = png_bytes(fig)
     plt.close(fig)
@@ -424,7 +428,7 @@ def fig_knee(d, plt):
         panel_style(ax, "% gait cycle", "BW")
         ax.legend(fontsize=6, loc="best")
     note = "" if d["meas_knee"] is not None else " (no measured knee_contact.sto in the trial)"
-    fig.suptitle(f"Knee contact force, BW = {d['mass']:g} kg x g{note}", fontsize=9)
+    fig.suptitle(f"Knee contact force, BW = {d['mass']:.2f} kg x g{note}", fontsize=9)
     out = png_bytes(fig)
     plt.close(fig)
     return out
@@ -473,7 +477,7 @@ def report_md(d, figures):
     rms = s.get("rms") if isinstance(s.get("rms"), dict) else {}
     lines = ["# gaitsim report", "",
              f"Solution `{os.path.abspath(d['dir'])}`; measured trial `{d['trial']}`; "
-             f"body weight {d['mass']:g} kg x {G} m/s² = {d['bw']:.1f} N.", "",
+             f"body weight {d['mass']:.3f} kg x {G} m/s² = {d['bw']:.1f} N.", "",
              "## Tracking errors (cf. Lin, Walter & Pandy 2018, Table 1)", "",
              "| quantity | unit | this solution (RMS) | Lin et al. 2018, participant 2 |",
              "|---|---|---|---|"]

@@ -10,25 +10,15 @@
 
 #include "callbacks/gs_mujoco.h"
 #include "callbacks/gs_physics.h"
-
-static double now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-static int cmp(const void* a, const void* b) {
-  double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
-}
+#include "tests/bench/bench_common.h"
 
 // seconds per mj_forward over `calls` calls
 static double time_forward(const mjModel* m, mjData* d, int calls) {
-  double t0 = now();
+  double t0 = bench_now();
   for (int c = 0; c < calls; c++) {
     mj_forward(m, d);
   }
-  return (now() - t0) / calls;
+  return (bench_now() - t0) / calls;
 }
 
 int main(int argc, char** argv) {
@@ -71,9 +61,7 @@ int main(int argc, char** argv) {
     gs_physics_install();
     tg[r] = time_forward(ours, dg, calls);
   }
-  qsort(tn, repeats, sizeof(double), cmp);
-  qsort(tg, repeats, sizeof(double), cmp);
-  double mn = tn[repeats / 2], mg = tg[repeats / 2];
+  double mn = bench_median(tn, repeats), mg = bench_median(tg, repeats);
   printf("model %s: nv %d, nu %d, native contacts %d\n", argv[1], native->nv, native->nu, dn->ncon);
   printf("mj_forward native muscles+contacts: median %.2f us (%d repeats x %d calls)\n", 1e6 * mn,
          repeats, calls);

@@ -38,28 +38,10 @@
 #include "optim/go_gait.h"
 #include "optim/go_gait_guess.h"
 #include "optim/go_jacobian.h"
+#include "tests/bench/bench_common.h"
 
 #define MAX_SMALL 16   // small node counts accepted on the command line
 #define MAX_REPEATS 99
-
-// monotonic wall clock (s)
-static double now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-// qsort comparison of doubles
-static int cmp(const void* a, const void* b) {
-  double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
-}
-
-// median of v (n >= 1; sorts v)
-static double median(double* v, int n) {
-  qsort(v, (size_t)n, sizeof(double), cmp);
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 // positive integer argument in [lo, hi], or -1
 static int parse_count(const char* s, int lo, int hi) {
@@ -141,9 +123,9 @@ static int time_jacobian(bench_problem* p, go_jac_mode mode, double* vals, doubl
   go_eval_counts c0, c1;
   go_nlp_set_jac_mode(p->nlp, mode);
   go_nlp_counts(p->nlp, &c0);
-  double t0 = now();
+  double t0 = bench_now();
   int rc = go_nlp_eval_jac(p->nlp, p->zs, vals);
-  *wall = now() - t0;
+  *wall = bench_now() - t0;
   go_nlp_counts(p->nlp, &c1);
   go_nlp_set_jac_mode(p->nlp, GO_JAC_SPARSE);
   if (rc != 0) {
@@ -177,12 +159,12 @@ typedef struct {
 static int measure(const mjModel* m, const gsTable* coords, const gsTable* grf, int N, int threads,
                    int repeats, int with_dense, bench_result* res) {
   bench_problem p;
-  double t_build = now();
+  double t_build = bench_now();
   if (problem_build(&p, m, coords, grf, N, threads) != 0) {
     problem_free(&p);
     return -1;
   }
-  t_build = now() - t_build;
+  t_build = bench_now() - t_build;
   printf("N=%d: n %d variables, m %d constraints, %d Jacobian nonzeros, %d colour groups, "
          "%d threads (set-up %.1f s)\n", N, p.n, p.m, p.nele, p.groups, threads, t_build);
   fflush(stdout);
@@ -219,9 +201,9 @@ static int measure(const mjModel* m, const gsTable* coords, const gsTable* grf, 
   res->n = p.n;
   res->evals_s = es;
   res->calls_s = cs;
-  res->wall_s = median(ws, repeats);
+  res->wall_s = bench_median(ws, repeats);
   res->evals_d = ed;
-  res->wall_d = with_dense ? median(wd, repeats) : 0;
+  res->wall_d = with_dense ? bench_median(wd, repeats) : 0;
   printf("  structured: %ld path evaluations (2 N groups = %ld) + %ld analytic path_jac calls; "
          "median %.4f s over %d repeats\n", es, 2L * N * p.groups, cs, res->wall_s, repeats);
   if (with_dense) {

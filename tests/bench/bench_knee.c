@@ -11,19 +11,9 @@
 
 #include "callbacks/gs_knee.h"
 #include "tests/gs_test_csv.h"
+#include "tests/bench/bench_common.h"
 
 #define MAXROWS 64
-
-static double now(void) {
-  struct timespec ts;
-  clock_gettime(CLOCK_MONOTONIC, &ts);
-  return ts.tv_sec + 1e-9 * ts.tv_nsec;
-}
-
-static int cmp(const void* a, const void* b) {
-  double x = *(const double*)a, y = *(const double*)b;
-  return (x > y) - (x < y);
-}
 
 // poses (first 6 numbers of every non-comment row)
 static int read_poses(const char* path, double q[MAXROWS][6]) {
@@ -103,29 +93,28 @@ int main(int argc, char** argv) {
   int inner = 200;
   for (int r = 0; r < repeats; r++) {
     gsKneeContact out;
-    double t0 = now();
+    double t0 = bench_now();
     for (int k = 0; k < inner; k++) {
       for (int i = 0; i < n; i++) {
         gs_knee_surrogate(&km, q[i], &out);
         sink += out.total;
       }
     }
-    ts[r] = (now() - t0) / (inner * n);
-    t0 = now();
+    ts[r] = (bench_now() - t0) / (inner * n);
+    t0 = bench_now();
     for (int i = 0; i < n; i++) {
       double R[9], t[3];
       gs_knee_pose(q[i], R, t);
       gs_knee_ef_eval(&ef, R, t, &out);
       sink += out.total;
     }
-    te[r] = (now() - t0) / n;
+    te[r] = (bench_now() - t0) / n;
   }
-  qsort(ts, (size_t)repeats, sizeof(double), cmp);
-  qsort(te, (size_t)repeats, sizeof(double), cmp);
+  double med_s = bench_median(ts, repeats), med_e = bench_median(te, repeats);
   printf("poses %d, surrogate elements %d + %d, elastic foundation %d elements x %d femoral faces\n",
          n, km.nelem[0], km.nelem[1], ef.ne, ef.nf);
   printf("surrogate_us=%.3f elastic_foundation_us=%.1f speedup=%.0f (checksum %.6g)\n",
-         1e6 * ts[repeats / 2], 1e6 * te[repeats / 2], te[repeats / 2] / ts[repeats / 2], sink);
+         1e6 * med_s, 1e6 * med_e, med_e / med_s, sink);
   gs_knee_ef_free(&ef);
   mj_deleteModel(m);
   return 0;

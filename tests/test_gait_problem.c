@@ -37,22 +37,13 @@ static double now(void) {
 // extras: the acceleration goal and the fibre-length rows
 static go_gait* make(const mjModel* m, const gsTable* coords, const gsTable* grf, int nthreads,
                      int extras) {
-  go_gait_opts o;
-  go_gait_opts_default(&o);
-  o.N = 4;
+  go_gait_opts o = gs_test_tracking_opts(coords, grf, 4);
   o.w_accel = extras ? W_ACCEL : 0;
   o.w_grm = extras ? W_GRM : 0;
   o.fibre_bounds = extras;
   o.nthreads = nthreads;
-  o.coords = coords;
-  o.grf = grf;
   o.speed = 1.27;
-  static const char* free_coords[] = {"pelvis_tz", NULL};
-  o.free_coords = free_coords;
-  char err[512];
-  go_gait* g = NULL;
-  if (go_gait_create(&g, m, &o, err, sizeof(err)) != 0) fprintf(stderr, "create: %s\n", err);
-  return g;
+  return gs_test_gait_create(m, &o);
 }
 
 int main(void) {

@@ -39,10 +39,7 @@ static go_gait* make(const mjModel* m, const gsTable* coords, const gsTable* grf
   o.nthreads = nthreads;
   o.coords = coords;
   o.grf = grf;
-  char err[512];
-  go_gait* g = NULL;
-  if (go_gait_create(&g, m, &o, err, sizeof(err)) != 0) fprintf(stderr, "create: %s\n", err);
-  return g;
+  return gs_test_gait_create(m, &o);
 }
 
 // J^T lambda (n) from the Jacobian values in pattern order

@@ -66,20 +66,6 @@ static void solver_cases(void) {
   }
 }
 
-static go_gait* make(const mjModel* m, const gsTable* coords, const gsTable* grf, int N) {
-  go_gait_opts o;
-  go_gait_opts_default(&o);
-  o.N = N;
-  o.coords = coords;
-  o.grf = grf;
-  static const char* free_coords[] = {"pelvis_tz", NULL};
-  o.free_coords = free_coords;
-  char err[512];
-  go_gait* g = NULL;
-  if (go_gait_create(&g, m, &o, err, sizeof(err)) != 0) fprintf(stderr, "create: %s\n", err);
-  return g;
-}
-
 static double violation(go_gait* g, const double* z) {
   go_nlp* nlp = go_gait_nlp(g);
   int n, mm, ne;
@@ -99,7 +85,8 @@ int main(void) {
   EXPECT_TRUE(m != NULL);
   if (!m) return GS_TEST_RESULT();
   const int N = 10;
-  go_gait* g = make(m, &coords, &grf, N);
+  go_gait_opts opts = gs_test_tracking_opts(&coords, &grf, N);
+  go_gait* g = gs_test_gait_create(m, &opts);
   EXPECT_TRUE(g != NULL);
   if (!g) return GS_TEST_RESULT();
   const go_gait_layout* L = go_gait_layout_get(g);

@@ -347,31 +347,38 @@ def panel_style(ax, xlabel, ylabel):
     ax.grid(alpha=0.3, linewidth=0.5)
 
 
-def png_bytes(fig):
+def png_bytes(fig, plt):
+    """The figure as PNG bytes (no Software metadata, so reruns are byte-identical); closes it."""
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=DPI, metadata={"Software": None})
+    plt.close(fig)
     return buf.getvalue()
+
+
+def panel_grid(plt, n, ncol, panel_w, panel_h, extra_h):
+    """A figure of n panels in rows of ncol (panel_w x panel_h inches each, extra_h for the
+    title): (figure, the n axes in reading order); the unused cells of the last row are hidden."""
+    nrow = (n + ncol - 1) // ncol
+    fig, axes = plt.subplots(nrow, ncol, figsize=(panel_w * ncol, panel_h * nrow + extra_h),
+                             layout="constrained", squeeze=False)
+    axes = axes.ravel()
+    for ax in axes[n:]:
+        ax.set_visible(False)
+    return fig, axes[:n]
 
 
 def fig_kinematics(d, plt):
     n = len(d["kin"])
-    ncol = 6
-    nrow = (n + ncol - 1) // ncol
-    fig, axes = plt.subplots(nrow, ncol, figsize=(2.3 * ncol, 1.9 * nrow + 0.6), layout="constrained")
-    axes = axes.ravel()
+    fig, axes = panel_grid(plt, n, 6, 2.3, 1.9, 0.6)
     for ax, (name, title, model, meas) in zip(axes, d["kin"]):
         ax.plot(d["meas_coords"].pct, meas, color="0.2", linestyle="--", linewidth=1.2, label="measured")
         ax.plot(d["states"].pct, model, color="tab:red", linewidth=1.2, label="model")
         ax.set_title(title, fontsize=8)
         panel_style(ax, "% gait cycle", "m" if name in TRANSLATIONS else "deg")
-    for ax in axes[n:]:
-        ax.set_visible(False)
     axes[0].legend(fontsize=6, loc="best")
     fig.suptitle("Kinematics: model (solid) vs measured (dashed), right heel strike to right heel strike",
                  fontsize=9)
-    out = png_bytes(fig)
-    plt.close(fig)
-    return out
+    return png_bytes(fig, plt)
 
 
 def fig_grf(d, plt):
@@ -386,9 +393,7 @@ def fig_grf(d, plt):
              f"; measured GRF x {d['grf_scale']:.4f} (grf_scale, as tracked)")
     fig.suptitle(f"Ground reaction forces, OpenSim frame (x forward, y up); BW = {d['mass']:.2f} kg x g"
                  f"{scale}", fontsize=9)
-    out = png_bytes(fig)
-    plt.close(fig)
-    return out
+    return png_bytes(fig, plt)
 
 
 def fig_knee(d, plt):
@@ -429,19 +434,13 @@ def fig_knee(d, plt):
         ax.legend(fontsize=6, loc="best")
     note = "" if d["meas_knee"] is not None else " (no measured knee_contact.sto in the trial)"
     fig.suptitle(f"Knee contact force, BW = {d['mass']:.2f} kg x g{note}", fontsize=9)
-    out = png_bytes(fig)
-    plt.close(fig)
-    return out
+    return png_bytes(fig, plt)
 
 
 def fig_excitations(d, plt):
     import numpy as np
     n = len(d["emg"])
-    ncol = 5
-    nrow = (n + ncol - 1) // ncol
-    fig, axes = plt.subplots(nrow, ncol, figsize=(2.4 * ncol, 2.0 * nrow + 0.6), layout="constrained",
-                             squeeze=False)
-    axes = axes.ravel()
+    fig, axes = panel_grid(plt, n, 5, 2.4, 2.0, 0.6)
     pct = d["controls"].pct
     shades = ["tab:red", "tab:orange", "tab:brown"]
     for ax, (ch, epct, mean, std, model) in zip(axes, d["emg"]):
@@ -455,13 +454,9 @@ def fig_excitations(d, plt):
         ax.set_ylim(0, 1.4)
         panel_style(ax, "% gait cycle", "/ peak")
         ax.legend(fontsize=5, loc="upper right")
-    for ax in axes[n:]:
-        ax.set_visible(False)
     fig.suptitle("Right-leg excitations (model, controls.sto) vs EMG envelope mean +- sd of a healthy "
                  "subject (Falisse et al. 2019), each / its peak: timing only", fontsize=9)
-    out = png_bytes(fig)
-    plt.close(fig)
-    return out
+    return png_bytes(fig, plt)
 
 
 def fmt_value(v):
@@ -782,25 +777,17 @@ def sweep_legend(ax, styles):
 
 def fig_sweep_kinematics(d, plt):
     n = len(SWEEP_KINEMATICS)
-    ncol = 5
-    nrow = (n + ncol - 1) // ncol
-    fig, axes = plt.subplots(nrow, ncol, figsize=(2.4 * ncol, 2.0 * nrow + 0.9),
-                             layout="constrained", squeeze=False)
-    axes = axes.ravel()
+    fig, axes = panel_grid(plt, n, 5, 2.4, 2.0, 0.9)
     styles = speed_styles(d, plt)
     for ax, (name, title) in zip(axes, SWEEP_KINEMATICS):
         for s, c, ls, w in styles:
             ax.plot(s["states"].pct, s["kin"][name], color=c, linestyle=ls, linewidth=w)
         ax.set_title(title, fontsize=8)
         panel_style(ax, "% stride", "m" if name in TRANSLATIONS else "deg")
-    for ax in axes[n:]:
-        ax.set_visible(False)
     sweep_legend(axes[0], styles)
     fig.suptitle("Kinematics per speed (cf. Lin et al. 2018 Fig. 4), right heel strike to right "
                  "heel strike", fontsize=9)
-    out = png_bytes(fig)
-    plt.close(fig)
-    return out
+    return png_bytes(fig, plt)
 
 
 def fig_sweep_grf(d, plt):
@@ -815,18 +802,12 @@ def fig_sweep_grf(d, plt):
             panel_style(ax, "% stride", "BW")
     sweep_legend(axes[0, 0], styles)
     fig.suptitle("Ground reaction forces per speed, BW (cf. Lin et al. 2018 Fig. 5)", fontsize=9)
-    out = png_bytes(fig)
-    plt.close(fig)
-    return out
+    return png_bytes(fig, plt)
 
 
 def fig_sweep_excitations(d, plt):
     n = len(d["muscles"])
-    ncol = 5
-    nrow = (n + ncol - 1) // ncol
-    fig, axes = plt.subplots(nrow, ncol, figsize=(2.4 * ncol, 1.9 * nrow + 0.9),
-                             layout="constrained", squeeze=False)
-    axes = axes.ravel()
+    fig, axes = panel_grid(plt, n, 5, 2.4, 1.9, 0.9)
     styles = speed_styles(d, plt)
     for ax, (m, title) in zip(axes, d["muscles"]):
         for s, c, ls, w in styles:
@@ -835,13 +816,9 @@ def fig_sweep_excitations(d, plt):
         ax.set_title(f"{title} ({m})", fontsize=7)
         panel_style(ax, "% stride", "excitation")
         ax.set_ylim(bottom=0)
-    for ax in axes[n:]:
-        ax.set_visible(False)
     sweep_legend(axes[0], styles)
     fig.suptitle("Right-leg muscle excitations per speed (cf. Lin et al. 2018 Fig. 6)", fontsize=9)
-    out = png_bytes(fig)
-    plt.close(fig)
-    return out
+    return png_bytes(fig, plt)
 
 
 def fig_sweep_gait(d, plt):
@@ -883,9 +860,7 @@ def fig_sweep_gait(d, plt):
         ax.legend(fontsize=6, loc="best")
     fig.suptitle("Stride time, stride length and cost of transport against speed (sweep.csv)",
                  fontsize=9)
-    out = png_bytes(fig)
-    plt.close(fig)
-    return out
+    return png_bytes(fig, plt)
 
 
 def fig_sweep_knee(d, plt):
@@ -904,9 +879,7 @@ def fig_sweep_knee(d, plt):
         panel_style(ax, "% stride", "BW")
     sweep_legend(axes[0][0], styles)
     fig.suptitle("Knee contact force per speed, BW (cf. Lin et al. 2018 Fig. 8)", fontsize=9)
-    out = png_bytes(fig)
-    plt.close(fig)
-    return out
+    return png_bytes(fig, plt)
 
 
 def sweep_report_md(d, figures):

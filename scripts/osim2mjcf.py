@@ -2118,28 +2118,30 @@ def standing_pose(model, zero, frames, soles):
         return p
 
     def calcaneus_bottoms(x):
-        """Bottom heights of spheres 1-4 per foot: {side: {index: height}}."""
+        """Bottoms (ground frame) of spheres 1-4 per foot at x: {side: [4 points]}."""
         _, bottoms = contact_spheres(model, x, soles)
-        return {side: {k: bottoms[side][k - 1][1] for k in (1, 2, 3, 4)} for side in bottoms}
+        return {side: bottoms[side][:4] for side in bottoms}
+
+    def mean_height(points):
+        return sum(p[1] for p in points) / len(points)
 
     def residual(u):
         x = xform(posed(u))
-        h = calcaneus_bottoms(x)
+        feet = calcaneus_bottoms(x)
         level = []
         for side in ("r", "l"):
-            b = h[side]
+            b = {k: feet[side][k - 1][1] for k in (1, 2, 3, 4)}
             level += [0.5 * (b[2] + b[3]) - 0.5 * (b[1] + b[4]),   # forefoot - heel
                       0.5 * (b[1] + b[2]) - 0.5 * (b[3] + b[4])]   # medial - lateral
-        _, bottoms = contact_spheres(model, x, soles)
-        fwd = [b[0] for side in bottoms for b in bottoms[side][:4]]   # spheres 1-4 stand
-        return level + [sum(h["r"].values()) / 4.0 - sum(h["l"].values()) / 4.0,
+        fwd = [p[0] for side in feet for p in feet[side]]
+        return level + [mean_height(feet["r"]) - mean_height(feet["l"]),
                         whole_body_com(model, x)[0] - 0.5 * (min(fwd) + max(fwd))]
 
     u = solve_newton(residual, [0.0] * 6)
     pose = posed(u)
     x = xform(pose)
     contacts, _ = contact_spheres(model, x, soles)
-    pose["pelvis_ty"] = -sum(calcaneus_bottoms(x)["r"].values()) / 4.0
+    pose["pelvis_ty"] = -mean_height(calcaneus_bottoms(x)["r"])
     x = xform(pose)
     _, bottoms = contact_spheres(model, x, soles)
     points = bottoms["r"] + bottoms["l"]

@@ -1,5 +1,6 @@
 // cmd_inspect.c: `gaitsim inspect MODEL --pose FILE --time t`: one row per muscle at one
-// instant: muscle-tendon length, fibre length, tendon tension, metabolic rate and moment arms.
+// instant: muscle-tendon length, fibre length, tendon tension, metabolic rate and moment arms;
+// then where the feet are: each contact sphere's bottom height and position, each foot's GRF.
 #include <getopt.h>
 #include <math.h>
 #include <stdio.h>
@@ -20,7 +21,9 @@ static const char* kInspectUsage =
     "or coordinates .mot; missing speeds are 0, missing activations A (default 0.05), missing\n"
     "excitations equal the activation, missing tendon forces in static equilibrium):\n"
     "muscle-tendon length lMT (m), fibre length lM (m) and lM/lopt, tendon tension F (N),\n"
-    "metabolic rate (W, Umberger 2010) and the moment arms (m or m/m) above 0.1 mm.\n";
+    "metabolic rate (W, Umberger 2010) and the moment arms (m or m/m) above 0.1 mm; then one\n"
+    "row per contact sphere: its bottom's height (mm; below 0: pressed into the floor) and\n"
+    "world x, y (m), and each foot's ground reaction and centre of pressure.\n";
 
 int gs_cmd_inspect(int argc, char** argv) {
   static const struct option options[] = {{"pose", required_argument, NULL, 'p'},
@@ -106,6 +109,24 @@ int gs_cmd_inspect(int argc, char** argv) {
       }
     }
     printf("\n");
+  }
+  // where the feet are: every contact sphere's bottom (centre height - radius; < 0 is the depth
+  // pressed into the floor) and position, then each foot's ground reaction
+  printf("%-16s %-4s %12s %9s %9s\n", "contact sphere", "foot", "bottom (mm)", "x (m)", "y (m)");
+  for (int g = 0; g < m->ngeom; g++) {
+    int side = gs_geom_contact_side(m, g);
+    if (side == 'r' || side == 'l') {
+      const double* p = d->geom_xpos + 3 * g;
+      printf("%-16s %-4c %12.1f %9.4f %9.4f\n", mj_id2name(m, mjOBJ_GEOM, g), side,
+             1e3 * (p[2] - m->geom_size[3 * g]), p[0], p[1]);
+    }
+  }
+  for (int s = 0; s < 2; s++) {
+    gsFootGrf fg;
+    gs_physics_foot_grf(m, d, s == 0 ? 'r' : 'l', 5.0, &fg);
+    printf("foot %c: ground reaction %.1f %.1f %.1f N (world x y z), centre of pressure %.4f "
+           "%.4f m%s\n", s == 0 ? 'r' : 'l', fg.force[0], fg.force[1], fg.force[2], fg.cop[0],
+           fg.cop[1], fg.loaded ? "" : " (unloaded)");
   }
   status = GS_EXIT_OK;
 done:

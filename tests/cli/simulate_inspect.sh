@@ -1,6 +1,9 @@
 #!/usr/bin/env bash
 # gaitsim simulate and inspect on the one-muscle bench: outputs written and readable; bad
 # input files give one line naming the file and exit 1, and leave earlier outputs intact.
+# inspect on jw_fullbody at the trial's right foot-flat instant (0.3 s of coordinates.mot): the
+# 12 contact spheres listed, the right calcaneus spheres pressed 0-15 mm into the floor (the
+# trial-calibrated feet; the earlier sole sat 25-26 mm deep at the heel), the left foot in swing.
 # usage: simulate_inspect.sh GAITSIM SOURCE_DIR
 set -u
 gaitsim=$1 src=$2
@@ -18,6 +21,14 @@ cp run/states.sto before.sto
 
 out=$("$gaitsim" inspect "$bench" --pose run/states.sto --time 0.1)
 check "inspect lists the muscle" grep -q '^muscle .*elastic' <<<"$out"
+
+out=$("$gaitsim" inspect "$src/mjmodels/jw_fullbody.xml" \
+  --pose "$src/mjmodels/trials/jw_ngait_og5/coordinates.mot" --time 0.3)
+check "inspect lists 12 contact spheres" test "$(grep -c '^contact_[rl]_[1-6] ' <<<"$out")" -eq 12
+check "right calcaneus spheres 0-15 mm deep at foot flat" awk '
+  /^contact_r_[1-4] / { n++; if (!($3 < 0 && $3 > -15)) bad = 1 }
+  END { exit !(n == 4 && !bad) }' <<<"$out"
+check "left foot unloaded in swing" grep -q '^foot l: .*(unloaded)$' <<<"$out"
 
 # bad inputs: one line, exit 1, earlier output untouched
 printf 'x\nversion=1\nnRows=1\nnColumns=2\nendheader\ntime\tdrop\n0\tnan\n' > nan.sto

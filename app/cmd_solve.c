@@ -409,7 +409,8 @@ static int write_knee_table(const char* out, const gsTable* knee) {
 }
 
 // write the solution tables and accumulate the RMS errors and the peak knee contact forces into
-// summary; knee_ref: measured total knee contact force (N) at the nodes, or NULL;
+// summary; knee_ref: measured medial, lateral and total knee contact force (N, N x 3) at the
+// nodes, or NULL; per coordinate the RMS and mean of model - measured (coordinate_errors);
 // knee_contact.sto only for a model with the right knee's knee_ty joint or the left knee's
 // tibia_l (its columns finite at every node); metabolics.sto: each muscle's metabolic power (W,
 // gs_physics_muscle_metabolics) and their sum, "total"
@@ -444,9 +445,11 @@ static int write_solution(go_gait* g, const double* z, const char* out, const do
     fprintf(stderr, "gaitsim: track: %s\n", err);
     goto done;
   }
-  // sums of squares: pelvis rot, pelvis trans, joint rot, grf ap, v, ml, knee contact, centre
-  // of pressure fore-aft and mediolateral; counts
-  double ss[9] = {0}, cnt[9] = {0};
+  // sums of squares: pelvis rot, pelvis trans, joint rot, grf ap, v, ml, knee contact total,
+  // centre of pressure fore-aft and mediolateral, knee contact medial and lateral; counts
+  double ss[11] = {0}, cnt[11] = {0};
+  // per coordinate: sum of the errors and of their squares (deg or cm), count
+  double* qsum = (double*)calloc(3 * (size_t)nv, sizeof(double));
   double peak_r = -INFINITY, peak_l = -INFINITY;  // largest total contact, right and left (N)
   for (int k = 0; k < N; k++) {
     const double* zk = z + (size_t)k * L->nz;
@@ -461,9 +464,12 @@ static int write_solution(go_gait* g, const double* z, const char* out, const do
     kc[3] = have_left && gs_knee_reaction(m, d, &left_knee, NULL, &kr) == 0 ? kr.compression : NAN;
     peak_r = isfinite(kc[2]) && !isnan(peak_r) ? fmax(peak_r, kc[2]) : NAN;
     peak_l = isfinite(kc[3]) && !isnan(peak_l) ? fmax(peak_l, kc[3]) : NAN;
-    if (knee_ref && isfinite(kc[2]) && isfinite(knee_ref[k])) {
-      ss[6] += sq((kc[2] - knee_ref[k]) / bw);
-      cnt[6]++;
+    for (int q = 0; knee_ref && q < 3; q++) {  // medial, lateral, total
+      int slot = q == 2 ? 6 : 9 + q;
+      if (isfinite(kc[q]) && isfinite(knee_ref[3 * k + q])) {
+        ss[slot] += sq((kc[q] - knee_ref[3 * k + q]) / bw);
+        cnt[slot]++;
+      }
     }
     double* mk = metab.data + (size_t)k * (na + 1);
     mk[na] = 0;
@@ -483,9 +489,13 @@ static int write_solution(go_gait* g, const double* z, const char* out, const do
       int grp = root ? (slide ? 1 : 0) : (slide ? -1 : 2);
       if (grp == 2 && (strcmp(name, "knee_adduction") == 0 || strcmp(name, "knee_rotation") == 0))
         grp = -1;
-      if (grp < 0) continue;
       double e = zk[L->x_q + j] - ref;
-      ss[grp] += sq(grp == 1 ? 100 * e : e * 180 / M_PI);
+      double e_unit = slide ? 100 * e : e * 180 / M_PI;  // cm or deg
+      qsum[3 * j] += e_unit;
+      qsum[3 * j + 1] += e_unit * e_unit;
+      qsum[3 * j + 2]++;
+      if (grp < 0) continue;
+      ss[grp] += sq(e_unit);
       cnt[grp]++;
     }
     for (int s = 0; s < 2; s++) {
@@ -511,14 +521,26 @@ static int write_solution(go_gait* g, const double* z, const char* out, const do
       }
     }
   }
-  static const char* keys[9] = {"pelvis_rot_deg", "pelvis_trans_cm", "joint_rot_deg",
-                                "grf_ap_bw",      "grf_v_bw",        "grf_ml_bw",
-                                "knee_contact_bw", "cop_ap_cm",      "cop_ml_cm"};
+  static const char* keys[11] = {"pelvis_rot_deg",   "pelvis_trans_cm",       "joint_rot_deg",
+                                 "grf_ap_bw",        "grf_v_bw",              "grf_ml_bw",
+                                 "knee_contact_bw",  "cop_ap_cm",             "cop_ml_cm",
+                                 "knee_medial_bw",   "knee_lateral_bw"};
   cJSON* rms = cJSON_AddObjectToObject(summary, "rms");
-  for (int q = 0; q < 9; q++) {
+  for (int q = 0; q < 11; q++) {
     if (cnt[q] > 0) cJSON_AddNumberToObject(rms, keys[q], sqrt(ss[q] / cnt[q]));
     else cJSON_AddNullToObject(rms, keys[q]);
   }
+  // every measured coordinate: RMS and mean of model - measured over the nodes
+  cJSON* qerr = cJSON_AddObjectToObject(summary, "coordinate_errors");
+  for (int j = 0; j < nv; j++) {
+    if (!(qsum[3 * j + 2] > 0)) continue;
+    int jnt = m->dof_jntid[j];
+    cJSON* e = cJSON_AddObjectToObject(qerr, mj_id2name(m, mjOBJ_JOINT, jnt));
+    cJSON_AddNumberToObject(e, "rms", sqrt(qsum[3 * j + 1] / qsum[3 * j + 2]));
+    cJSON_AddNumberToObject(e, "mean", qsum[3 * j] / qsum[3 * j + 2]);
+    cJSON_AddStringToObject(e, "unit", m->jnt_type[jnt] == mjJNT_SLIDE ? "cm" : "deg");
+  }
+  free(qsum);
   if (L->tx >= 0) {
     double dx = z[(size_t)(N - 1) * L->nz + L->x_q + L->tx] - z[L->x_q + L->tx];
     cJSON_AddNumberToObject(summary, "speed_mps", dx / T);
@@ -630,8 +652,9 @@ static void print_blocks(go_gait* g, const double* gv, const char* when) {
   free(gl), free(gu), free(xl), free(xu), free(v);
 }
 
-// measured total knee contact force (N) of the trial at the N node times (caller frees), or NULL
-// when the trial has no knee_contact.sto with a contact_total_r column
+// measured knee contact force (N) of the trial at the N node times, N x 3: medial, lateral,
+// total (NAN where the file lacks the column); caller frees. NULL when the trial has no
+// knee_contact.sto with a contact_total_r column
 static double* measured_knee_contact(const char* trial, const go_gait* g) {
   char path[4096], err[256];
   snprintf(path, sizeof(path), "%s/knee_contact.sto", trial);
@@ -641,12 +664,15 @@ static double* measured_knee_contact(const char* trial, const go_gait* g) {
   int N = go_gait_nodes(g);
   double* out = NULL;
   double* times = (double*)malloc(sizeof(double) * (size_t)N);
-  if (gs_storage_read(path, &t, err, sizeof(err)) == 0) {
-    int c = gs_table_column(&t, "contact_total_r");
+  if (gs_storage_read(path, &t, err, sizeof(err)) == 0 &&
+      gs_table_column(&t, "contact_total_r") >= 0) {
     for (int k = 0; k < N; k++) times[k] = t.time[0] + go_gait_stride_time(g) * k / (N - 1);
-    if (c >= 0 && gs_table_resample(&t, times, N, &rs, err, sizeof(err)) == 0) {
-      out = (double*)malloc(sizeof(double) * (size_t)N);
-      for (int k = 0; k < N; k++) out[k] = rs.data[k * rs.ncol + c];
+    if (gs_table_resample(&t, times, N, &rs, err, sizeof(err)) == 0) {
+      out = (double*)malloc(sizeof(double) * 3 * (size_t)N);
+      for (int q = 0; q < 3; q++) {
+        int c = gs_table_column(&rs, kKneeLabels[q]);
+        for (int k = 0; k < N; k++) out[3 * k + q] = c >= 0 ? rs.data[k * rs.ncol + c] : NAN;
+      }
     }
   }
   free(times);

@@ -104,6 +104,8 @@ TABLE1 = [
     ("grf_ml_bw", "GRF mediolateral", "BW", "0.02"),
     ("joint_rot_deg", "Joint rotations", "deg", "1.98"),
     ("knee_contact_bw", "Knee contact force", "BW", "0.32"),
+    ("knee_medial_bw", "Knee contact, medial compartment", "BW", "-"),
+    ("knee_lateral_bw", "Knee contact, lateral compartment", "BW", "-"),
     # not in the paper's table: where the feet push (both feet, nodes with > 0.1 BW measured)
     ("cop_ap_cm", "Centre of pressure fore-aft", "cm", "-"),
     ("cop_ml_cm", "Centre of pressure mediolateral", "cm", "-"),

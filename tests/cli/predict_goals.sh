@@ -6,7 +6,8 @@
 # fibre block in the violation lines) and --no-fibre-bounds removes their 93 x 5 rows; the accel
 # weight parses for track and predict, a negative one is bad usage (exit 2). Without --model,
 # predict continues on the model the guess's summary.json names (here the placeholder-knee
-# jw_fullbody.xml), else on the bundled default (jw_fullbody_knee6.xml).
+# jw_fullbody.xml), else on the bundled default (jw_fullbody_knee6.xml). A 5-node tracking
+# summary's coordinate_errors agree with its joint RMS; the knee compartments' RMS are there.
 # usage: predict_goals.sh GAITSIM SOURCE_DIR
 set -u
 gaitsim=$1 src=$2
@@ -60,6 +61,27 @@ sys.exit(0 if json.load(open('on/summary.json'))['model'].endswith('/jw_fullbody
 
 "$gaitsim" predict --guess "$guess" --speed 0.8 --out x --weight accel=-1 >/dev/null 2>&1
 check "predict --weight accel=-1: usage, exit 2" test $? -eq 2
+# tracking summary: every measured coordinate's error (RMS >= |mean|), the joint RMS the mean
+# square of the paper's joint set (non-pelvis rotations but knee adduction and rotation), and
+# the six-DOF knee's medial and lateral contact RMS
+"$gaitsim" track "$src/mjmodels/trials/jw_ngait_og5" --out tr --nodes 5 --max-iter 0 --no-polish \
+  --threads 1 >/dev/null 2>&1
+check "track at 0 iterations: exit 3" test $? -eq 3
+check "coordinate errors agree with the joint RMS" /usr/bin/python3 - tr/summary.json <<'PY'
+import json, math, sys
+s = json.load(open(sys.argv[1]))
+ce, rms = s["coordinate_errors"], s["rms"]
+joints = [v for k, v in ce.items() if v["unit"] == "deg" and not k.startswith("pelvis_")
+          and k not in ("knee_adduction", "knee_rotation")]
+joint_rms = math.sqrt(sum(v["rms"] ** 2 for v in joints) / len(joints))
+ok = (len(ce) >= 20 and all(v["rms"] >= abs(v["mean"]) - 1e-12 for v in ce.values())
+      and abs(joint_rms - rms["joint_rot_deg"]) <= 1e-9 * rms["joint_rot_deg"]
+      and rms["knee_medial_bw"] > 0 and rms["knee_lateral_bw"] > 0)
+if not ok:
+    print(json.dumps({"joint_rms": joint_rms, "rms": rms}), file=sys.stderr)
+sys.exit(0 if ok else 1)
+PY
+
 "$gaitsim" track nowhere --out x --weight accel=-1 >/dev/null 2>&1
 check "track --weight accel=-1: usage, exit 2" test $? -eq 2
 "$gaitsim" track nowhere --out x --weight accel=1 >/dev/null 2>&1

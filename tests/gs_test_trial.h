@@ -16,7 +16,7 @@
 // Load the prepared full-body model and the trial's coordinates.mot and grf.mot (radians, model
 // names, as gaitsim track reads them). Returns the model (mj_deleteModel), or NULL when anything
 // failed (the reason is on stderr); coords and grf are initialised either way (gs_table_free).
-static mjModel* gs_test_load_trial(gsTable* coords, gsTable* grf) {
+static inline mjModel* gs_test_load_trial(gsTable* coords, gsTable* grf) {
   gs_table_init(coords);
   gs_table_init(grf);
   mjModel* m = gs_app_load_model(GAITSIM_SOURCE_DIR "/mjmodels/jw_fullbody.xml");

@@ -39,6 +39,7 @@
 #include "optim/go_gait_guess.h"
 #include "optim/go_jacobian.h"
 #include "tests/bench/bench_common.h"
+#include "tests/gs_test_trial.h"
 
 #define MAX_SMALL 16   // small node counts accepted on the command line
 #define MAX_REPEATS 99
@@ -75,15 +76,11 @@ static int problem_build(bench_problem* p, const mjModel* m, const gsTable* coor
                          const gsTable* grf, int N, int threads) {
   char err[1024];
   memset(p, 0, sizeof(*p));
-  // options of `gaitsim track` (its defaults for the goal weights)
-  static const char* free_coords[] = {"pelvis_tz", NULL};
-  go_gait_opts go;
-  go_gait_opts_default(&go);
-  go.N = N;
+  // the tracking problem of the tests (pelvis_tz free when the model has it); goal weights as
+  // `gaitsim track`'s of 2026-11 (the Jacobian's cost does not depend on them)
+  go_gait_opts go = gs_test_tracking_opts(coords, grf, N);
   go.nthreads = threads;
-  go.coords = coords;
-  go.grf = grf;
-  go.free_coords = mj_name2id(m, mjOBJ_JOINT, "pelvis_tz") >= 0 ? free_coords : NULL;
+  if (mj_name2id(m, mjOBJ_JOINT, "pelvis_tz") < 0) go.free_coords = NULL;
   go.w_pelvis_rot = go.w_pelvis_trans = go.w_grf = 10.0;
   go.w_joint = 1.0;
   go.w_effort = 0.1;

@@ -92,6 +92,7 @@ typedef struct {
   int predict;         // 1: the predictive problem (gaitsim predict)
   const char* guess;   // predict: solution folder to start from (the tracking solution)
   double speed;        // predict: prescribed mean speed (m/s)
+  double metabolic_smoothing;  // predict: factor on the smooth Umberger widths (-), 1
 } gsTrackOptions;
 
 // --weight NAME=VALUE
@@ -151,6 +152,7 @@ static void defaults(gsTrackOptions* o) {
   o->w_effort = 50.0;  // 0.1 left mean activation at 0.37 (co-contraction); issue #6 note
   o->w_accel = 0.0;    // tracking: none (results stay as they were); predict: PREDICT_W_ACCEL
   o->fibre_bounds = 0; // tracking: none; predict: on (--no-fibre-bounds)
+  o->metabolic_smoothing = 1.0;
 }
 
 static int parse(int argc, char** argv, gsTrackOptions* o) {
@@ -544,6 +546,15 @@ static int write_solution(go_gait* g, const double* z, const char* out, const do
   if (L->tx >= 0) {
     double dx = z[(size_t)(N - 1) * L->nz + L->x_q + L->tx] - z[L->x_q + L->tx];
     cJSON_AddNumberToObject(summary, "speed_mps", dx / T);
+    // the exact (unsmoothed) Umberger 2010 cost of transport of metabolics.sto's totals, by the
+    // solve's trapezoid: what the smooth objective approximates (J/(kg m))
+    double energy = 0;
+    for (int k = 0; k + 1 < N; k++)
+      energy += 0.5 * (T / (N - 1)) * (metab.data[(size_t)k * (na + 1) + na] +
+                                       metab.data[(size_t)(k + 1) * (na + 1) + na]);
+    if (fabs(dx) > 1e-9)
+      cJSON_AddNumberToObject(summary, "cost_of_transport_exact_j_per_kg_m",
+                              energy / (mj_getTotalmass(m) * fabs(dx)));
   }
   // peak knee contact over the nodes: right (implant; measured in vivo) and left (1-DOF joint
   // reaction), N and BW; null without the column or with a non-finite node
@@ -732,6 +743,13 @@ static char* trial_of_solution(const char* dir) {
 // at 0.8 m/s (polished) it cut RMS qddot from 62 to 45 and the peak from 353 to 183 rad/s^2 at
 // 0.06 % of J (1: 23 and 113, 0.13 %); small enough not to move the cost of transport
 #define PREDICT_W_ACCEL 0.1
+// default factor on the smooth Umberger 2010 widths of predict (-): with the widths of
+// gs_umberger_smoothing_default (steps 0.01 wide in u - a, lM~ - 1 and v~ in lopt/s) no full-body
+// prediction reached Ipopt's stopping test in up to 1500 L-BFGS iterations; 10 times wider, 0.8
+// m/s reached the acceptable level after 477 and 2.0 m/s the optimal solution after 993 from the
+// same tracking solution, and the exact (unsmoothed) cost of transport of the solution differs by
+// 1.8 % (docs/BENCHMARKS.md, 2026-12-02); 3 times wider did not converge in 1000 at 0.8 m/s
+#define PREDICT_METABOLIC_SMOOTHING 10.0
 static int predict_setup(const mjModel* m, gsTrackOptions* o, go_gait_opts* go, double** band,
                          double* T0, double* dx0) {
   gsTable states, controls;
@@ -856,6 +874,7 @@ static void predict_summary(const go_gait* g, const double* z, const gsTrackOpti
   cJSON_AddNumberToObject(summary, "stride_length_change_pct", 100 * (dx / dx0 - 1));
   cJSON_AddNumberToObject(summary, "cost_of_transport_j_per_kg_m", cot);
   cJSON_AddNumberToObject(summary, "regularisation_share", objective > 0 ? 1 - cot / objective : NAN);
+  cJSON_AddNumberToObject(summary, "metabolic_smoothing", o->metabolic_smoothing);
   static const char* peaks[] = {"soleus", "gasmed", "gaslat", "soleus_l", "med_gas_l", "lat_gas_l"};
   cJSON* pk = cJSON_AddObjectToObject(summary, "peak_excitation");
   for (size_t q = 0; q < sizeof(peaks) / sizeof(peaks[0]); q++) {
@@ -889,6 +908,10 @@ static const char* kPredictUsage =
     "  --no-fibre-bounds   no path bounds 0.25 <= lM/lopt <= 1.5 on every muscle's normalised\n"
     "                      fibre length (Lin, Walter & Pandy 2018, eq. 2; on by default; the\n"
     "                      guess's count outside them is printed)\n"
+    "  --metabolic-smoothing F  factor on every width of the smooth Umberger 2010 rates\n"
+    "                      (steps in u - a, lM~ - 1 and v~, the maxima and minima; widths of\n"
+    "                      gs_metabolics.h times F; default 10: steps 0.1 wide, which lets the\n"
+    "                      solves converge; summary.json gives the exact cost of transport too)\n"
     "  --no-polish         no feasibility polish of a solve that stopped short\n"
     "  --ipopt KEY=VALUE   extra Ipopt option (repeatable)\n";
 
@@ -900,18 +923,20 @@ int gs_cmd_predict(int argc, char** argv) {
       {"max-iter", required_argument, NULL, 'i'}, {"max-time", required_argument, NULL, 'T'},
       {"weight", required_argument, NULL, 'w'},   {"no-polish", no_argument, NULL, 'P'},
       {"ipopt", required_argument, NULL, 'p'},    {"help", no_argument, NULL, 'h'},
-      {"no-fibre-bounds", no_argument, NULL, 'F'}, {NULL, 0, NULL, 0}};
+      {"no-fibre-bounds", no_argument, NULL, 'F'},
+      {"metabolic-smoothing", required_argument, NULL, 'S'}, {NULL, 0, NULL, 0}};
   gsTrackOptions o;
   defaults(&o);
   o.predict = 1;
   o.nodes = 20;
   o.w_effort = 0.01;
   o.w_accel = PREDICT_W_ACCEL;
+  o.metabolic_smoothing = PREDICT_METABOLIC_SMOOTHING;
   o.fibre_bounds = 1;
   optind = 1;
   int c, bad = 0, model_given = 0;
   char err[256], *end;
-  while ((c = getopt_long(argc, argv, "g:s:o:m:n:t:i:T:w:PFp:h", options, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, "g:s:o:m:n:t:i:T:w:PFS:p:h", options, NULL)) != -1) {
     switch (c) {
       case 'g': o.guess = optarg; break;
       case 's':
@@ -933,6 +958,10 @@ int gs_cmd_predict(int argc, char** argv) {
       case 'w': bad |= parse_weight(optarg, &o); break;
       case 'P': o.polish = 0; break;
       case 'F': o.fibre_bounds = 0; break;
+      case 'S':
+        o.metabolic_smoothing = strtod(optarg, &end);
+        bad |= *end || end == optarg || !(o.metabolic_smoothing > 0 && o.metabolic_smoothing <= 1e3);
+        break;
       case 'p':
         if (go_ipopt_opts_add(&o.ipopt, optarg, err, sizeof(err)) != 0) {
           fprintf(stderr, "gaitsim: predict: %s\n", err);
@@ -1004,6 +1033,7 @@ static int solve(gsTrackOptions o) {
   go.nthreads = o.threads;
   go.w_effort = o.w_effort;
   go.w_accel = o.w_accel;
+  go.metabolic_smoothing = o.metabolic_smoothing;
   if (!o.predict) {
     go.coords = &coords;
     go.grf = &grf;

@@ -77,6 +77,7 @@ struct go_gait {
   int n_ivars;
   double cot_scale;           // w_cot / (m V): metabolic integrand factor      (s / (kg m))
   gsUmbergerMuscle* umus;     // metabolic parameters (na)
+  gsUmbergerSmoothing umb_smooth;  // widths of the smooth Umberger 2010 rates
   int free_time;              // T is the last NLP variable
   go_bound_override* band;    // eq. 3 bounds as node overrides (n_band)
   int n_band;
@@ -105,6 +106,7 @@ void go_gait_opts_default(go_gait_opts* o) {
   o->periodic = 1;
   o->fibre_lo = 0.25;
   o->fibre_hi = 1.5;
+  o->metabolic_smoothing = 1.0;
 }
 
 go_nlp* go_gait_nlp(go_gait* g) { return g->nlp; }
@@ -352,7 +354,7 @@ static void muscle_powers(const go_gait* g, mjData* d, const double* z, int kine
     gsMuscleOut out;
     gs_physics_muscle_tension(m, d, i, &out);
     gsUmbergerInput in = {d->ctrl[i], d->act[i], out.lM_norm, out.vM, out.f_active, out.fL};
-    P[i] = gs_umberger2010_smooth(&g->umus[i], &in, NULL, NULL);
+    P[i] = gs_umberger2010_smooth(&g->umus[i], &in, &g->umb_smooth, NULL);
   }
 }
 
@@ -904,6 +906,18 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   // cost of transport: integrand w_cot Edot / (m V); with J = I / T that is w_cot COT
   g->cot_scale = o->w_cot > 0 ? o->w_cot / (mj_getTotalmass(m) * g->speed) : 0;
   g->umus = (gsUmbergerMuscle*)zalloc((size_t)na, sizeof(gsUmbergerMuscle));
+  if (!(o->metabolic_smoothing > 0 && isfinite(o->metabolic_smoothing))) {
+    snprintf(err, errsz, "go_gait_create: metabolic_smoothing must be > 0");
+    go_gait_free(g);
+    return -1;
+  }
+  gs_umberger_smoothing_default(&g->umb_smooth);
+  g->umb_smooth.w_excitation *= o->metabolic_smoothing;
+  g->umb_smooth.w_length *= o->metabolic_smoothing;
+  g->umb_smooth.w_velocity *= o->metabolic_smoothing;
+  g->umb_smooth.w_cap *= o->metabolic_smoothing;
+  g->umb_smooth.w_heat *= o->metabolic_smoothing;
+  g->umb_smooth.w_force *= o->metabolic_smoothing;
   for (int i = 0; i < na; i++) {
     if (gs_umberger_muscle_from_user(m->actuator_user + i * m->nuser_actuator, &g->umus[i], NULL,
                                      0) != 0 && g->cot_scale > 0) {

@@ -128,6 +128,8 @@ typedef struct {
   const double* band_qd;            // half-width per dof of the speed band (nv; <= 0: none)
   int fibre_bounds;                 // 1: fibre path rows fibre_lo <= lM/lopt <= fibre_hi (eq. 2)
   double fibre_lo, fibre_hi;        // bounds of the normalised fibre length lM / lopt     (-)
+  double metabolic_smoothing;       // factor on every width of gs_umberger_smoothing_default
+                                    // (the smooth steps and max/min of the cost; eps_a kept) (-)
 } go_gait_opts;
 
 // Where everything sits in z_k and in the path rows of a node.

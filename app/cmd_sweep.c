@@ -30,8 +30,9 @@ static const char* kSweepUsage =
     "LIST is A:STEP:B (m/s, e.g. 0.8:0.2:2.0) or comma-separated speeds. Writes DIR/predict_V/\n"
     "(the solver's progress in DIR/predict_V/log.txt), DIR/sweep.csv and DIR/sweep.md.\n\n"
     "  --nodes N       collocation nodes (default 20)\n"
-    "  --max-time S    wall-clock limit of each solve, s (default 600)\n"
-    "  --max-iter N    Ipopt iteration limit of each solve (default 1000)\n";
+    "  --max-time S    wall-clock limit of each solve, s (default none: the iteration limit,\n"
+    "                  so that the results do not depend on the load of the machine)\n"
+    "  --max-iter N    Ipopt iteration limit of each solve (default 1500)\n";
 
 // speeds from "A:STEP:B" or "V1,V2,..." into v (ascending); count, or -1 when malformed
 static int parse_speeds(const char* s, double* v) {
@@ -104,9 +105,9 @@ static int solve_one(const char* guess, double v, const char* out, const char* n
   FILE* lf = fopen(log, "w");
   if (lf) dup2(fileno(lf), 2);
   char* argv[] = {"predict", "--guess", (char*)guess, "--speed", speed, "--out", (char*)out,
-                  "--nodes", (char*)nodes, "--threads", "1", "--max-time", (char*)max_time,
-                  "--max-iter", (char*)max_iter, NULL};
-  int rc = gs_cmd_predict(15, argv);
+                  "--nodes", (char*)nodes, "--threads", "1", "--max-iter", (char*)max_iter,
+                  max_time ? "--max-time" : NULL, (char*)max_time, NULL};
+  int rc = gs_cmd_predict(max_time ? 15 : 13, argv);
   fflush(stderr);
   if (lf) {
     dup2(saved, 2);
@@ -141,8 +142,8 @@ int gs_cmd_sweep(int argc, char** argv) {
       {"max-time", required_argument, NULL, 'T'}, {"max-iter", required_argument, NULL, 'i'},
       {"help", no_argument, NULL, 'h'},
       {NULL, 0, NULL, 0}};
-  const char *guess = NULL, *list = NULL, *dir = NULL, *nodes = "20", *max_time = "600",
-             *max_iter = "1000";
+  const char *guess = NULL, *list = NULL, *dir = NULL, *nodes = "20", *max_time = NULL,
+             *max_iter = "1500";
   optind = 1;
   int c;
   while ((c = getopt_long(argc, argv, "g:s:o:n:T:i:h", options, NULL)) != -1) {

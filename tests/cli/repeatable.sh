@@ -3,9 +3,9 @@
 # the default trial, 20 nodes, 8 Ipopt iterations, no polish, 2 threads, MUMPS ordering PORD
 # (`--ipopt mumps_pivot_order=4`). Checks that gaitsim's own evaluations (threaded Jacobian,
 # objective, constraints) repeat bitwise. With the default ordering (5) runs differ from
-# iteration 3 on in the 9th digit: Debian's MUMPS orders through SCOTCH there, which is not
-# repeatable (docs/BENCHMARKS.md, "Reproducible runs"); five such runs on 2026-12-02 gave four
-# different objectives at iteration 8. About 15 s.
+# iteration 3 on in the 9th digit (so do SCOTCH's, 3; Debian's MUMPS links no METIS, and why
+# these orderings vary is not known: docs/BENCHMARKS.md, "Reproducible runs"); five such runs on
+# 2026-12-02 gave four different objectives at iteration 8, and this test fails. About 15 s.
 # usage: repeatable.sh GAITSIM SOURCE_DIR
 set -u
 gaitsim=$1 src=$2

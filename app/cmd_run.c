@@ -114,7 +114,8 @@ int gs_cmd_run(int argc, char** argv) {
     stopped_short |= rc == GS_EXIT_STOPPED_SHORT;
   }
 
-  // 2. predictions (gaitsim sweep): each speed from the nearest solved one, here the tracking solution
+  // 2. predictions (gaitsim sweep): each speed from the nearest one solved, for the default
+  // speeds the tracking solution
   char sweep_dir[4096];
   snprintf(sweep_dir, sizeof(sweep_dir), "%s/sweep", out);
   printf("[2] predictive solves at %s m/s from the tracking solution -> %s\n",

@@ -960,7 +960,8 @@ int gs_cmd_predict(int argc, char** argv) {
       case 'F': o.fibre_bounds = 0; break;
       case 'S':
         o.metabolic_smoothing = strtod(optarg, &end);
-        bad |= *end || end == optarg || !(o.metabolic_smoothing > 0 && o.metabolic_smoothing <= 1e3);
+        bad |= *end || end == optarg ||
+               !(o.metabolic_smoothing > 0 && o.metabolic_smoothing <= 1e3);
         break;
       case 'p':
         if (go_ipopt_opts_add(&o.ipopt, optarg, err, sizeof(err)) != 0) {

@@ -107,7 +107,9 @@ static int solve_one(const char* guess, double v, const char* out, const char* n
   char* argv[] = {"predict", "--guess", (char*)guess, "--speed", speed, "--out", (char*)out,
                   "--nodes", (char*)nodes, "--threads", "1", "--max-iter", (char*)max_iter,
                   max_time ? "--max-time" : NULL, (char*)max_time, NULL};
-  int rc = gs_cmd_predict(max_time ? 15 : 13, argv);
+  int argc = 0;  // the words before the first NULL (no --max-time without a limit)
+  while (argv[argc]) argc++;
+  int rc = gs_cmd_predict(argc, argv);
   fflush(stderr);
   if (lf) {
     dup2(saved, 2);

@@ -903,14 +903,14 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
     go_gait_free(g);
     return -1;
   }
-  // cost of transport: integrand w_cot Edot / (m V); with J = I / T that is w_cot COT
-  g->cot_scale = o->w_cot > 0 ? o->w_cot / (mj_getTotalmass(m) * g->speed) : 0;
-  g->umus = (gsUmbergerMuscle*)zalloc((size_t)na, sizeof(gsUmbergerMuscle));
   if (!(o->metabolic_smoothing > 0 && isfinite(o->metabolic_smoothing))) {
     snprintf(err, errsz, "go_gait_create: metabolic_smoothing must be > 0");
     go_gait_free(g);
     return -1;
   }
+  // cost of transport: integrand w_cot Edot / (m V); with J = I / T that is w_cot COT
+  g->cot_scale = o->w_cot > 0 ? o->w_cot / (mj_getTotalmass(m) * g->speed) : 0;
+  g->umus = (gsUmbergerMuscle*)zalloc((size_t)na, sizeof(gsUmbergerMuscle));
   gs_umberger_smoothing_default(&g->umb_smooth);
   g->umb_smooth.w_excitation *= o->metabolic_smoothing;
   g->umb_smooth.w_length *= o->metabolic_smoothing;

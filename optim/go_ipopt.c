@@ -151,6 +151,8 @@ typedef struct {
   int best_iter;
   double best_f, best_viol;  // scaled objective, violation
   int iterations;
+  double last_inf_pr, last_inf_du, last_mu;  // as Ipopt reports them at the latest iteration
+  int last_alg_mod;                          // 1: restoration phase
   int stop_reason;  // 0 none, 1 interrupted, 2 wall time
   struct timespec t0;
 } solve_state;
@@ -269,6 +271,10 @@ static Bool cb_iter(Index alg_mod, Index iter, Number obj, Number inf_pr, Number
                     UserDataPtr u) {
   solve_state* s = u;
   s->iterations = iter;
+  s->last_inf_pr = inf_pr;
+  s->last_inf_du = inf_du;
+  s->last_mu = mu;
+  s->last_alg_mod = (int)alg_mod;
   if (s->have_xj) score(s, s->xj, iter);
   double t = elapsed(&s->t0);
   if (s->opts->progress) {
@@ -357,6 +363,7 @@ int go_ipopt_solve(go_nlp* nlp, const go_ipopt_opts* opts, double* z, double* z_
   double* gu = gl + m;
   solve_state s;
   memset(&s, 0, sizeof(s));
+  s.last_inf_pr = s.last_inf_du = s.last_mu = NAN;  // until the first iteration is reported
   s.nlp = nlp;
   s.opts = opts;
   s.n = n;
@@ -447,6 +454,10 @@ int go_ipopt_solve(go_nlp* nlp, const go_ipopt_opts* opts, double* z, double* z_
   res->ipopt_status = st;
   res->status = map_status(st, s.stop_reason);
   res->iterations = s.iterations;
+  res->last_inf_pr = s.last_inf_pr;
+  res->last_inf_du = s.last_inf_du;
+  res->last_mu = s.last_mu;
+  res->last_restoration = s.last_alg_mod != 0;
   double f = NAN, viol = INFINITY;
   if (!go_nlp_eval_g(nlp, x, s.gtmp)) viol = m > 0 ? go_nlp_violation(nlp, s.gtmp) : 0.0;
   if (go_nlp_eval_f(nlp, x, &f)) f = NAN;

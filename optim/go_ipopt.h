@@ -76,6 +76,10 @@ typedef struct {
   int best_iter;            // iteration of the best iterate (-1: none scored)
   double best_objective;    // physical objective at the best iterate
   double best_viol;         // max scaled constraint violation at the best iterate
+  double last_inf_pr;       // Ipopt's primal infeasibility at its last iteration (scaled, max norm)
+  double last_inf_du;       // Ipopt's dual infeasibility at its last iteration (scaled, max norm)
+  double last_mu;           // Ipopt's barrier parameter at its last iteration (-)
+  int last_restoration;     // 1: the last iteration was a restoration-phase iteration
 } go_solve_result;
 
 // optional multipliers in the solver's scaling: in (when warm != 0) and out (when non-NULL)

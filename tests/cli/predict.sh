@@ -55,6 +55,25 @@ if not ok:
     print(json.dumps(s, indent=1), file=sys.stderr)
 sys.exit(0 if ok else 1)
 PY
+# summary.json ipopt_last_iteration: the primal and dual infeasibility of the solve's last
+# progress line (printed to 4 digits), before the polish's own lines
+check "ipopt_last_iteration: the last progress line" /usr/bin/python3 - pred/summary.json log.txt <<'PY'
+import json, re, sys
+s = json.load(open(sys.argv[1]))["ipopt_last_iteration"]
+last = None
+for line in open(sys.argv[2]):
+    if "feasibility polish" in line:
+        break
+    m = re.match(r"iter +(\d+)(r?) .* inf_pr (\S+)  inf_du (\S+)  lg\(mu\) +(\S+)", line)
+    if m:
+        last = m
+ok = (last is not None and int(last[1]) == 3 and s["restoration"] == (last[2] == "r")
+      and abs(s["inf_pr"] / float(last[3]) - 1) <= 1e-3 and abs(s["inf_du"] / float(last[4]) - 1) <= 1e-3
+      and abs(s["mu"] / 10 ** float(last[5]) - 1) <= 0.13)
+if not ok:
+    print(s, last and last.groups(), file=sys.stderr)
+sys.exit(0 if ok else 1)
+PY
 
 "$gaitsim" predict --speed 0.8 --out x >/dev/null 2>&1
 check "no --guess: usage, exit 2" test $? -eq 2

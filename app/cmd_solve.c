@@ -158,6 +158,10 @@ static void defaults(gsTrackOptions* o) {
   o->w_accel = 0.0;    // tracking: none (results stay as they were); predict: PREDICT_W_ACCEL
   o->fibre_bounds = 0; // tracking: none; predict: on (--no-fibre-bounds)
   o->metabolic_smoothing = 1.0;
+  // fall-back guard: stop when the objective rises 25 % above the lowest one reached at a
+  // violation <= 1e-4 (the acceptable level's), and restart from the best iterate (solve())
+  o->ipopt.fallback_rise = 0.25;
+  o->ipopt.fallback_viol = 1e-4;
 }
 
 static int parse(int argc, char** argv, gsTrackOptions* o) {
@@ -391,6 +395,7 @@ static int guess_from_variables(const go_gait* g, const char* dir, double* z) {
 // (1-DOF) knee compressive joint reaction along the tibia (gs_knee_reaction.h), and the right
 // knee's ligament tension, the sum over its bundles (surrogate knee only)
 #define GS_KNEE_COLUMNS 5
+#define GS_MAX_RESTARTS 2  // restarts from the best iterate after fall-backs (solve())
 static const char* const kKneeLabels[GS_KNEE_COLUMNS] = {
     "contact_medial_r", "contact_lateral_r", "contact_total_r", "contact_total_l",
     "ligament_total_r"};
@@ -1011,6 +1016,7 @@ static int solve(gsTrackOptions o) {
   go_hess* hess = NULL;
   double *z = NULL, *zb = NULL, *zs = NULL, *gv = NULL;
   cJSON* summary = NULL;
+  cJSON* restarts = NULL;  // summary.json "restarts", one object per restart after a fall-back
   char path[4096], err[1024];
   const char* what = o.predict ? "predict" : "track";
   double grf_scale = 0, *band = NULL, T0 = 0, dx0 = 0;
@@ -1109,6 +1115,54 @@ static int solve(gsTrackOptions o) {
     free(lam);
     goto done;
   }
+  // restarts after a fall-back: Ipopt once came near a solution (violation <= 1e-4) and left it
+  // (the adaptive barrier's fixed mode or a restoration phase raised mu by 3-9 decades and the
+  // objective by 40-600 %; docs/BENCHMARKS.md, "Fall-backs and restarts"). Start again from the
+  // best iterate with the iterations left, the bound multipliers set from a small barrier
+  // (z = mu / s) so that the adaptive update starts small, and the point barely pushed off its
+  // bounds; at most GS_MAX_RESTARTS times
+  restarts = cJSON_CreateArray();
+  int n_restarts = 0;
+  while (res.status == GO_SOLVE_FELL_BACK && res.best_iter >= 0 && n_restarts < GS_MAX_RESTARTS &&
+         (o.max_iter < 0 || res.iterations < o.max_iter) &&
+         (o.max_time <= 0 || res.wall_s < o.max_time)) {
+    cJSON* rj = cJSON_CreateObject();
+    cJSON_AddNumberToObject(rj, "after_iterations", res.iterations);
+    cJSON_AddNumberToObject(rj, "from_iteration", res.best_iter);
+    cJSON_AddNumberToObject(rj, "objective", res.best_objective);
+    cJSON_AddNumberToObject(rj, "violation", res.best_viol);
+    cJSON_AddItemToArray(restarts, rj);
+    fprintf(stderr, "%s: fell back after %d iterations; restart from the best iterate (iteration "
+            "%d, objective %.6g, violation %.3g)\n", what, res.iterations, res.best_iter,
+            res.best_objective, res.best_viol);
+    go_ipopt_opts ro = o.ipopt;
+    if (o.max_iter >= 0) ro.max_iter = o.max_iter - res.iterations;
+    if (o.max_time > 0) ro.max_wall_s = o.max_time - res.wall_s;
+    static const char* restart_opts[][2] = {{"bound_mult_init_method", "mu-based"},
+                                            {"mu_init", "1e-6"}, {"bound_push", "1e-8"},
+                                            {"bound_frac", "1e-8"}};
+    for (size_t i = 0; i < sizeof(restart_opts) / sizeof(restart_opts[0]); i++)
+      if (go_ipopt_opts_set(&ro, restart_opts[i][0], restart_opts[i][1], err, sizeof(err)) != 0) {
+        fprintf(stderr, "gaitsim: track: restart: %s\n", err);
+        free(lam);
+        goto done;
+      }
+    memcpy(z, zb, sizeof(double) * (size_t)n);
+    go_solve_result r2;
+    if (go_ipopt_solve(nlp, &ro, z, zb, lam ? &mult : NULL, &r2, err, sizeof(err)) != 0) {
+      fprintf(stderr, "gaitsim: track: restart: %s\n", err);
+      free(lam);
+      goto done;
+    }
+    // the restart's iteration 0 is the best iterate itself (pushed 1e-8 off its bounds), so its
+    // best iterate is at least as good; counts and times add up
+    r2.iterations += res.iterations;
+    r2.best_iter = r2.best_iter >= 0 ? r2.best_iter + res.iterations : -1;
+    r2.wall_s += res.wall_s;
+    r2.cpu_s += res.cpu_s;
+    res = r2;
+    n_restarts++;
+  }
   if (lam) print_largest_multipliers(g, lam, o.predict ? "predict" : "track");
   free(lam);
   int converged = res.status == GO_SOLVE_SUCCESS || res.status == GO_SOLVE_ACCEPTABLE;
@@ -1181,6 +1235,8 @@ static int solve(gsTrackOptions o) {
   }
   cJSON_AddStringToObject(summary, "status", go_solve_status_str(res.status));
   cJSON_AddNumberToObject(summary, "iterations", res.iterations);
+  cJSON_AddItemToObject(summary, "restarts", restarts);  // after fall-backs, in order
+  restarts = NULL;
   // Ipopt's own measures at its last iteration (scaled problem; before the polish)
   cJSON* lj = cJSON_AddObjectToObject(summary, "ipopt_last_iteration");
   cJSON_AddNumberToObject(lj, "inf_pr", res.last_inf_pr);
@@ -1242,6 +1298,7 @@ static int solve(gsTrackOptions o) {
 
 done:
   cJSON_Delete(summary);
+  cJSON_Delete(restarts);
   free(z), free(zb), free(zs), free(gv), free(band);
   go_hess_free(hess);
   go_gait_free(g);

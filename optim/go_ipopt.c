@@ -153,7 +153,9 @@ typedef struct {
   int iterations;
   double last_inf_pr, last_inf_du, last_mu;  // as Ipopt reports them at the latest iteration
   int last_alg_mod;                          // 1: restoration phase
-  int stop_reason;  // 0 none, 1 interrupted, 2 wall time
+  double low_obj;   // lowest physical objective of iterations with inf_pr <= fallback_viol
+  int have_low_obj;
+  int stop_reason;  // 0 none, 1 interrupted, 2 wall time, 3 fell back (fallback_rise)
   struct timespec t0;
 } solve_state;
 
@@ -293,6 +295,21 @@ static Bool cb_iter(Index alg_mod, Index iter, Number obj, Number inf_pr, Number
     s->stop_reason = 2;
     return FALSE;
   }
+  if (s->opts->fallback_rise > 0 && !alg_mod && isfinite(obj)) {
+    double J = go_nlp_objective_phys(s->nlp, obj);
+    if (s->have_low_obj && J > s->low_obj + s->opts->fallback_rise * fabs(s->low_obj)) {
+      if (s->opts->progress)
+        fprintf(s->opts->progress, "fell back: objective %.6g, %.0f %% above the %.6g reached at "
+                "a violation <= %.0e; stopping\n", J, 100.0 * (J / s->low_obj - 1.0), s->low_obj,
+                s->opts->fallback_viol);
+      s->stop_reason = 3;
+      return FALSE;
+    }
+    if (inf_pr <= s->opts->fallback_viol && (!s->have_low_obj || J < s->low_obj)) {
+      s->low_obj = J;
+      s->have_low_obj = 1;
+    }
+  }
   return TRUE;
 }
 
@@ -306,7 +323,8 @@ static go_solve_status map_status(int st, int stop_reason) {
     case Diverging_Iterates: return GO_SOLVE_DIVERGING;
     case User_Requested_Stop:
       return stop_reason == 1 ? GO_SOLVE_INTERRUPTED
-             : stop_reason == 2 ? GO_SOLVE_MAX_WALL_TIME : GO_SOLVE_INTERNAL_ERROR;
+             : stop_reason == 2 ? GO_SOLVE_MAX_WALL_TIME
+             : stop_reason == 3 ? GO_SOLVE_FELL_BACK : GO_SOLVE_INTERNAL_ERROR;
     case Maximum_Iterations_Exceeded: return GO_SOLVE_MAX_ITER;
     case Maximum_CpuTime_Exceeded: return GO_SOLVE_MAX_CPU_TIME;
     case Restoration_Failed: return GO_SOLVE_RESTORATION_FAILED;
@@ -336,6 +354,7 @@ const char* go_solve_status_str(go_solve_status st) {
     case GO_SOLVE_EVAL_ERROR: return "invalid number in function or derivative evaluation";
     case GO_SOLVE_BAD_PROBLEM: return "invalid problem definition";
     case GO_SOLVE_BAD_OPTION: return "invalid option";
+    case GO_SOLVE_FELL_BACK: return "fell back from the solution it had reached";
     case GO_SOLVE_INTERNAL_ERROR: return "internal error";
   }
   return "unknown status";

@@ -36,6 +36,13 @@ typedef struct {
   double best_viol_tol;   // violations at or below count as feasible for the best iterate
   FILE* progress;         // one line per iteration; NULL: silent
   int handle_sigint;      // 1: Ctrl-C stops the solve cleanly (handler restored afterwards)
+  double fallback_rise;   // > 0: stop (GO_SOLVE_FELL_BACK) at the first iteration outside the
+                          // restoration phase whose objective exceeds, by more than this
+                          // fraction of its size, the lowest objective of the earlier iterations
+                          // with inf_pr <= fallback_viol (the solve had come near a solution and
+                          // left it); 0: off
+  double fallback_viol;   // the violation (scaled, max norm, Ipopt's inf_pr) below which an
+                          // iteration counts as near a solution for fallback_rise
   int gauss_newton;       // 1: Ipopt's exact-Hessian mode with the Gauss-Newton Hessian
                           // (go_nlp_eval_hess_diag; the problem needs integrand_hess);
                           // 0: limited-memory quasi-Newton (L-BFGS)
@@ -62,6 +69,8 @@ typedef enum {
   GO_SOLVE_EVAL_ERROR,         // invalid number in a function or derivative
   GO_SOLVE_BAD_PROBLEM,        // not enough degrees of freedom or invalid problem definition
   GO_SOLVE_BAD_OPTION,         // invalid option
+  GO_SOLVE_FELL_BACK,          // stopped by fallback_rise: the objective rose far above the
+                               // lowest one reached near feasibility
   GO_SOLVE_INTERNAL_ERROR,     // exceptions, memory, internal errors, user stop of unknown cause
 } go_solve_status;
 

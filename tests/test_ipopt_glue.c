@@ -114,6 +114,38 @@ int main(void) {
   printf("iteration limit: %s after %d, best iterate %d (viol %.2e, J %.4f), start viol %.2e\n",
          go_solve_status_str(r.status), r.iterations, r.best_iter, r.best_viol, r.best_objective, v0);
 
+  // fall-back guard: the guess's effort 0.25 (u = 0.5) rises to the optimum's 12 (u = 6 - 12 t)
+  // as Ipopt makes it feasible. With every iterate counting as near a solution (fallback_viol
+  // 1e10) a rise of 50 % above the lowest objective stops the solve at the first iteration above
+  // 0.375, with its own status; the last iteration's measures are reported
+  go_ipopt_opts_default(&o);
+  o.fallback_rise = 0.5;
+  o.fallback_viol = 1e10;
+  guess(z);
+  EXPECT_EQ_INT(0, solve(nlp, &o, z, zb, NULL, &r, &rc, err));
+  EXPECT_EQ_INT(GO_SOLVE_FELL_BACK, r.status);
+  EXPECT_TRUE(r.iterations >= 1 && r.iterations < 10);
+  EXPECT_TRUE(r.objective > 0.375);
+  EXPECT_TRUE(isfinite(r.last_inf_pr) && isfinite(r.last_inf_du) && r.last_mu > 0);
+  EXPECT_EQ_INT(0, r.last_restoration);
+  printf("fall-back guard: %s after %d iterations, J %.4f\n", go_solve_status_str(r.status),
+         r.iterations, r.objective);
+  // the same guard with a violation no iterate reaches never fires: the solve converges to the
+  // objective of the solve without the guard (12.12 on this grid), in as many iterations
+  o.fallback_rise = 0.0;
+  guess(z);
+  EXPECT_EQ_INT(0, solve(nlp, &o, z, zb, NULL, &r, &rc, err));
+  double j_ref = r.objective;
+  int it_ref = r.iterations;
+  o.fallback_rise = 0.5;
+  o.fallback_viol = 1e-30;
+  guess(z);
+  EXPECT_EQ_INT(0, solve(nlp, &o, z, zb, NULL, &r, &rc, err));
+  EXPECT_EQ_INT(GO_SOLVE_SUCCESS, r.status);
+  EXPECT_NEAR(j_ref, r.objective, 1e-12);
+  EXPECT_EQ_INT(it_ref, r.iterations);
+  EXPECT_NEAR(12.0, r.objective, 0.2);
+
   // ./ipopt.opt in the working directory is not read (it would stop after 1 iteration and print)
   char cwd[4096], dir[] = "/tmp/gs_test_ipoptopt_XXXXXX";
   EXPECT_TRUE(getcwd(cwd, sizeof(cwd)) != NULL);

@@ -1,0 +1,81 @@
+#!/usr/bin/env python3
+"""Replay an acceptable-level stopping test on gaitsim progress logs (diagnostic, docs/BENCHMARKS.md).
+
+usage: replay_stop_rule.py LOG [LOG ...]
+
+A progress log is what `gaitsim track` / `gaitsim predict` print to stderr: one line per Ipopt
+iteration, "iter K[r]  obj J  inf_pr P  inf_du D  lg(mu) M ...". For each log and each rule
+(violation tolerance, relative objective change per iteration, consecutive iterations) this prints
+the first iteration at which the rule holds, and how far its objective is above the lowest objective
+of the log's iterates with inf_pr <= 1e-6 (%). It replays only the parts of Ipopt 3.11's acceptable
+test that the log shows (constraint violation, objective change); the complementarity and overall
+error parts are not printed there, so Ipopt may stop later than the replay says. It may also stop
+earlier: when its line search fails at a point that passes the test once, Ipopt ends there at the
+acceptable level without the consecutive iterations.
+Restoration-phase iterations ("r") break a run of consecutive iterations; the feasibility polish
+that follows a solve (its lines come after "feasibility polish") is left out.
+"""
+import re
+import sys
+
+PROGRESS = re.compile(r"iter\s+(\d+)(r?)\s+obj\s+(\S+)\s+inf_pr\s+(\S+)")
+RULES = [  # (violation, objective change, iterations)
+    (1e-6, 1e-4, 15),  # gaitsim's rule before commit 3ed244e
+    (1e-4, 1e-4, 15),  # gaitsim's rule since
+    (3e-5, 1e-4, 10),
+    (1e-5, 1e-4, 5),
+]
+
+
+def read_log(path):
+    rows = []
+    with open(path, encoding="utf-8", errors="replace") as f:
+        for line in f:
+            if "feasibility polish" in line:
+                break
+            m = PROGRESS.match(line)
+            if m:
+                rows.append((int(m[1]), m[2] == "r", float(m[3]), float(m[4])))
+    return rows
+
+
+def first_stop(rows, viol_tol, obj_tol, n_iter):
+    count, prev = 0, None
+    for it, resto, obj, inf_pr in rows:
+        ok = (not resto and inf_pr <= viol_tol and prev is not None
+              and abs(obj - prev) / max(1.0, abs(obj)) <= obj_tol)
+        count = count + 1 if ok else 0
+        prev = obj
+        if count >= n_iter:
+            return it, obj
+    return None
+
+
+def main(paths):
+    if not paths:
+        print(__doc__.strip().splitlines()[2], file=sys.stderr)
+        return 2
+    print("log | last iteration | lowest J (inf_pr <= 1e-6) | " +
+          " | ".join(f"stop at viol {v:g}, dJ {o:g}, {n} its" for v, o, n in RULES))
+    for path in paths:
+        try:
+            rows = read_log(path)
+        except OSError as e:
+            print(f"replay_stop_rule.py: {path}: {e.strerror}", file=sys.stderr)
+            return 1
+        if not rows:
+            print(f"replay_stop_rule.py: {path}: no progress lines", file=sys.stderr)
+            return 1
+        feasible = [r[2] for r in rows if r[3] <= 1e-6]
+        jmin = min(feasible) if feasible else float("nan")
+        cells = []
+        for rule in RULES:
+            hit = first_stop(rows, *rule)
+            cells.append("-" if hit is None else
+                         f"{hit[0]} ({(hit[1] / jmin - 1) * 100:+.2f} %)" if feasible else f"{hit[0]}")
+        print(f"{path} | {rows[-1][0]} | {jmin:.4f} | " + " | ".join(cells))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))

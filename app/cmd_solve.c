@@ -68,6 +68,10 @@ static const char* kTrackUsage =
     "  --no-polish         no feasibility polish (by default a solve that stops short is\n"
     "                      followed by a Gauss-Newton projection of its best iterate onto the\n"
     "                      dynamics: the nearest dynamically consistent point)\n"
+    "  --fallback-rise F   stop when the objective rises by more than the fraction F above the\n"
+    "                      lowest one reached at a violation <= 1e-4, and restart from the\n"
+    "                      best iterate (at most twice; summary.json restarts); default 0.25,\n"
+    "                      0 turns the guard off\n"
     "  --ipopt KEY=VALUE   extra Ipopt option (repeatable)\n";
 
 typedef struct {
@@ -174,12 +178,13 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
       {"hessian", required_argument, NULL, 'H'},  {"weight", required_argument, NULL, 'w'},
       {"init", required_argument, NULL, 'I'},     {"no-polish", no_argument, NULL, 'P'},
       {"guess-method", required_argument, NULL, 'G'},
+      {"fallback-rise", required_argument, NULL, 'R'},
       {"help", no_argument, NULL, 'h'},           {NULL, 0, NULL, 0}};
   defaults(o);
   optind = 1;
   int c;
   char *end;
-  while ((c = getopt_long(argc, argv, "o:m:n:t:i:T:a:p:H:w:I:G:Ph", options, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, "o:m:n:t:i:T:a:p:H:w:I:G:R:Ph", options, NULL)) != -1) {
     switch (c) {
       case 'o': o->out = optarg; break;
       case 'm': o->model = optarg; break;
@@ -195,6 +200,10 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
       case 'T':
         o->max_time = strtod(optarg, &end);
         if (*end || end == optarg || !(o->max_time > 0)) return -1;
+        break;
+      case 'R':
+        o->ipopt.fallback_rise = strtod(optarg, &end);
+        if (*end || end == optarg || !(o->ipopt.fallback_rise >= 0)) return -1;
         break;
       case 'a':
         o->activation = strtod(optarg, &end);
@@ -923,6 +932,10 @@ static const char* kPredictUsage =
     "                      gs_metabolics.h times F; default 10: steps 0.1 wide, which lets the\n"
     "                      solves converge; summary.json gives the exact cost of transport too)\n"
     "  --no-polish         no feasibility polish of a solve that stopped short\n"
+    "  --fallback-rise F   stop when the objective rises by more than the fraction F above the\n"
+    "                      lowest one reached at a violation <= 1e-4, and restart from the\n"
+    "                      best iterate (at most twice; summary.json restarts); default 0.25,\n"
+    "                      0 turns the guard off\n"
     "  --ipopt KEY=VALUE   extra Ipopt option (repeatable)\n";
 
 int gs_cmd_predict(int argc, char** argv) {
@@ -934,7 +947,8 @@ int gs_cmd_predict(int argc, char** argv) {
       {"weight", required_argument, NULL, 'w'},   {"no-polish", no_argument, NULL, 'P'},
       {"ipopt", required_argument, NULL, 'p'},    {"help", no_argument, NULL, 'h'},
       {"no-fibre-bounds", no_argument, NULL, 'F'},
-      {"metabolic-smoothing", required_argument, NULL, 'S'}, {NULL, 0, NULL, 0}};
+      {"metabolic-smoothing", required_argument, NULL, 'S'},
+      {"fallback-rise", required_argument, NULL, 'R'},        {NULL, 0, NULL, 0}};
   gsTrackOptions o;
   defaults(&o);
   o.predict = 1;
@@ -946,7 +960,7 @@ int gs_cmd_predict(int argc, char** argv) {
   optind = 1;
   int c, bad = 0, model_given = 0;
   char err[256], *end;
-  while ((c = getopt_long(argc, argv, "g:s:o:m:n:t:i:T:w:PFS:p:h", options, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, "g:s:o:m:n:t:i:T:w:PFS:R:p:h", options, NULL)) != -1) {
     switch (c) {
       case 'g': o.guess = optarg; break;
       case 's':
@@ -968,6 +982,10 @@ int gs_cmd_predict(int argc, char** argv) {
       case 'w': bad |= parse_weight(optarg, &o); break;
       case 'P': o.polish = 0; break;
       case 'F': o.fibre_bounds = 0; break;
+      case 'R':
+        o.ipopt.fallback_rise = strtod(optarg, &end);
+        bad |= *end || end == optarg || !(o.ipopt.fallback_rise >= 0);
+        break;
       case 'S':
         o.metabolic_smoothing = strtod(optarg, &end);
         bad |= *end || end == optarg ||

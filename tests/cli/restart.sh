@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# The fall-back guard and the restarts from the best iterate, end to end on the planar model
+# (mjmodels/gait2d.xml, 20 nodes; about 50 s on 2 cores): a 100-iteration track as the guess, then
+# a prediction at 1.2 m/s with the guard made hair-trigger (--fallback-rise 1e-4: a rise of 0.01 %
+# above the lowest objective reached at a violation <= 1e-4 counts as a fall-back). Measured
+# 2026-12-02: first fall-back after 280 iterations, the two restarts used up by 291. Expected:
+# exit 3 with the status "fell back from the solution it had reached", two restarts in
+# summary.json in order (each after more iterations than the one before, each from an iteration
+# no later than its stop, with the objective and violation of the best iterate it started from,
+# violation <= 1e-4), the iterations of all three solves summed, the polished result feasible to
+# 1e-6, and the progress naming both restarts; --fallback-rise with a negative value is a usage
+# error (exit 2).
+# usage: restart.sh GAITSIM SOURCE_DIR
+set -u
+gaitsim=$1 src=$2
+source "$(dirname "$0")/../cli_common.bash"
+
+"$gaitsim" track "$src/mjmodels/trials/jw_ngait_og5" --out track --model "$src/mjmodels/gait2d.xml" \
+  --nodes 20 --max-iter 100 --threads 2 >/dev/null 2>&1
+check "guess written" test -s track/variables.sto
+"$gaitsim" predict --guess track --model "$src/mjmodels/gait2d.xml" --speed 1.2 --nodes 20 \
+  --max-iter 600 --threads 2 --out pred --fallback-rise 1e-4 >/dev/null 2>log.txt
+status=$?
+check "fell back: exit 3 (got $status)" test "$status" -eq 3
+check "two restarts in the progress" test "$(grep -c 'restart from the best iterate' log.txt)" -eq 2
+check "summary: status, restarts, iterations" /usr/bin/python3 - pred/summary.json <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+r = s["restarts"]
+ok = (s["status"] == "fell back from the solution it had reached" and len(r) == 2
+      and 0 < r[0]["after_iterations"] < r[1]["after_iterations"] < s["iterations"] <= 600
+      and all(x["from_iteration"] <= x["after_iterations"] and x["violation"] <= 1e-4
+              and x["objective"] > 0 for x in r)
+      and s["max_violation"] <= 1e-6)
+if not ok:
+    print(json.dumps({k: s.get(k) for k in ("status", "iterations", "restarts", "max_violation")}),
+          file=sys.stderr)
+sys.exit(0 if ok else 1)
+PY
+"$gaitsim" predict --guess track --speed 1.2 --out x --fallback-rise -1 >/dev/null 2>&1
+check "negative --fallback-rise: usage, exit 2" test $? -eq 2
+finish

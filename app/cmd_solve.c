@@ -72,6 +72,10 @@ static const char* kTrackUsage =
     "                      lowest one reached at a violation <= 1e-4, and restart from the\n"
     "                      best iterate (at most twice; summary.json restarts); default 0.25,\n"
     "                      0 turns the guard off\n"
+    "  --refine N          after an L-BFGS solve that stopped short, up to N Newton\n"
+    "                      iterations with the exact Hessian (structured finite differences)\n"
+    "                      from its best iterate (default 150, at most 600 s; 0: none;\n"
+    "                      summary.json refine)\n"
     "  --ipopt KEY=VALUE   extra Ipopt option (repeatable)\n";
 
 typedef struct {
@@ -92,6 +96,8 @@ typedef struct {
   int fibre_bounds;    // predict: 1: 0.25 <= lM/lopt <= 1.5 path rows (go_gait_opts.fibre_bounds)
   int pqn;             // 1: partitioned quasi-Newton Hessian (go_hessian.h)
   int hess_fd;         // 1: exact Hessian by structured finite differences (go_hess_create_fd)
+  int refine_iter;     // track: Newton iterations with the exact Hessian after an L-BFGS solve
+                       // that stopped short (0: none)
   int polish;          // 1: feasibility polish after a solve that stopped short
   int predict;         // 1: the predictive problem (gaitsim predict)
   const char* guess;   // predict: solution folder to start from (the tracking solution)
@@ -126,6 +132,13 @@ static int parse_int(const char* s, int lo, int* v) {
   *v = (int)x;
   return 0;
 }
+
+// Newton iterations with the exact Hessian (go_hess_create_fd) that follow an L-BFGS tracking
+// solve which stopped short: from the main job's 600-iteration N = 20 solution they reached Ipopt's
+// acceptable level after 78 (238 s, 2 threads), J -3.8 % (docs/BENCHMARKS.md, "Exact-Hessian
+// refinement of the tracking solve")
+#define GS_REFINE_ITER 150
+#define GS_REFINE_WALL_S 600.0  // wall-clock cap of the refinement (s)
 
 // the defaults of every option (tracking; gaitsim predict changes a few)
 static void defaults(gsTrackOptions* o) {
@@ -162,6 +175,7 @@ static void defaults(gsTrackOptions* o) {
   o->w_accel = 0.0;    // tracking: none (results stay as they were); predict: PREDICT_W_ACCEL
   o->fibre_bounds = 0; // tracking: none; predict: on (--no-fibre-bounds)
   o->metabolic_smoothing = 1.0;
+  o->refine_iter = GS_REFINE_ITER;  // tracking only; predict sets 0
   // fall-back guard: stop when the objective rises 25 % above the lowest one reached at a
   // violation <= 1e-4 (the acceptable level's), and restart from the best iterate (solve())
   o->ipopt.fallback_rise = 0.25;
@@ -179,12 +193,13 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
       {"init", required_argument, NULL, 'I'},     {"no-polish", no_argument, NULL, 'P'},
       {"guess-method", required_argument, NULL, 'G'},
       {"fallback-rise", required_argument, NULL, 'R'},
+      {"refine", required_argument, NULL, 'r'},
       {"help", no_argument, NULL, 'h'},           {NULL, 0, NULL, 0}};
   defaults(o);
   optind = 1;
   int c;
   char *end;
-  while ((c = getopt_long(argc, argv, "o:m:n:t:i:T:a:p:H:w:I:G:R:Ph", options, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, "o:m:n:t:i:T:a:p:H:w:I:G:R:r:Ph", options, NULL)) != -1) {
     switch (c) {
       case 'o': o->out = optarg; break;
       case 'm': o->model = optarg; break;
@@ -204,6 +219,9 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
       case 'R':
         o->ipopt.fallback_rise = strtod(optarg, &end);
         if (*end || end == optarg || !(o->ipopt.fallback_rise >= 0)) return -1;
+        break;
+      case 'r':
+        if (parse_int(optarg, 0, &o->refine_iter)) return -1;
         break;
       case 'a':
         o->activation = strtod(optarg, &end);
@@ -952,6 +970,7 @@ int gs_cmd_predict(int argc, char** argv) {
   gsTrackOptions o;
   defaults(&o);
   o.predict = 1;
+  o.refine_iter = 0;  // the exact Hessian leaves out the cost of transport's curvature
   o.nodes = 20;
   o.w_effort = 0.01;
   o.w_accel = PREDICT_W_ACCEL;
@@ -1181,6 +1200,69 @@ static int solve(gsTrackOptions o) {
     res = r2;
     n_restarts++;
   }
+  // exact-Hessian refinement of an L-BFGS tracking solve that stopped short: Newton from the best
+  // iterate with a small barrier (mu 1e-6, bound multipliers mu / s, the point barely pushed off
+  // its bounds); its result replaces the L-BFGS one only when Ipopt reaches its optimal or
+  // acceptable level, otherwise the L-BFGS best iterate stays
+  go_solve_result rres;
+  int refined = -1;  // -1 not run, 0 run and not used, 1 used
+  if (o.refine_iter > 0 && !o.hess_fd && !o.pqn && !o.ipopt.gauss_newton && res.best_iter >= 0 &&
+      res.status != GO_SOLVE_SUCCESS && res.status != GO_SOLVE_ACCEPTABLE &&
+      res.status != GO_SOLVE_INTERRUPTED && (o.max_time <= 0 || res.wall_s < o.max_time)) {
+    if (go_hess_create_fd(&hess, nlp, go_gait_elements(g), err, sizeof(err)) != 0) {
+      fprintf(stderr, "gaitsim: track: refine: %s\n", err);
+      free(lam);
+      goto done;
+    }
+    go_ipopt_opts ro = o.ipopt;
+    ro.hess = hess;
+    ro.max_iter = o.refine_iter;
+    // at most GS_REFINE_WALL_S, or what is left of --max-time (at N = 80 one exact-Hessian
+    // iteration costs about 4 times the N = 20 one)
+    ro.max_wall_s = o.max_time > 0 ? fmin(o.max_time - res.wall_s, GS_REFINE_WALL_S)
+                                   : GS_REFINE_WALL_S;
+    static const char* refine_opts[][2] = {{"bound_mult_init_method", "mu-based"},
+                                           {"mu_init", "1e-6"}, {"bound_push", "1e-8"},
+                                           {"bound_frac", "1e-8"}};
+    for (size_t i = 0; i < sizeof(refine_opts) / sizeof(refine_opts[0]); i++)
+      if (go_ipopt_opts_set(&ro, refine_opts[i][0], refine_opts[i][1], err, sizeof(err)) != 0) {
+        fprintf(stderr, "gaitsim: track: refine: %s\n", err);
+        free(lam);
+        goto done;
+      }
+    fprintf(stderr, "%s: %s after %d iterations; exact-Hessian refinement from the best iterate "
+            "(iteration %d, objective %.6g, violation %.3g), up to %d iterations\n", what,
+            go_solve_status_str(res.status), res.iterations, res.best_iter, res.best_objective,
+            res.best_viol, o.refine_iter);
+    double* zr = (double*)malloc(sizeof(double) * (size_t)n);
+    double* zrb = (double*)malloc(sizeof(double) * (size_t)n);
+    if (!zr || !zrb) {
+      free(zr), free(zrb), free(lam);
+      fprintf(stderr, "gaitsim: track: out of memory (refine)\n");
+      goto done;
+    }
+    memcpy(zr, zb, sizeof(double) * (size_t)n);
+    if (go_ipopt_solve(nlp, &ro, zr, zrb, lam ? &mult : NULL, &rres, err, sizeof(err)) != 0) {
+      fprintf(stderr, "gaitsim: track: refine: %s\n", err);
+      free(zr), free(zrb), free(lam);
+      goto done;
+    }
+    refined = rres.status == GO_SOLVE_SUCCESS || rres.status == GO_SOLVE_ACCEPTABLE;
+    fprintf(stderr, "%s: refinement: %s after %d iterations, %.1f s, objective %.6g%s\n", what,
+            go_solve_status_str(rres.status), rres.iterations, rres.wall_s, rres.objective,
+            refined ? "" : "; the L-BFGS best iterate stays");
+    if (refined) {
+      memcpy(z, zr, sizeof(double) * (size_t)n);
+      memcpy(zb, zrb, sizeof(double) * (size_t)n);
+      go_solve_result merged = rres;
+      merged.iterations += res.iterations;
+      merged.best_iter = rres.best_iter >= 0 ? rres.best_iter + res.iterations : -1;
+      merged.wall_s += res.wall_s;
+      merged.cpu_s += res.cpu_s;
+      res = merged;
+    }
+    free(zr), free(zrb);
+  }
   if (lam) print_largest_multipliers(g, lam, o.predict ? "predict" : "track");
   free(lam);
   int converged = res.status == GO_SOLVE_SUCCESS || res.status == GO_SOLVE_ACCEPTABLE;
@@ -1255,6 +1337,15 @@ static int solve(gsTrackOptions o) {
   cJSON_AddNumberToObject(summary, "iterations", res.iterations);
   cJSON_AddItemToObject(summary, "restarts", restarts);  // after fall-backs, in order
   restarts = NULL;
+  if (refined >= 0) {
+    cJSON* fj = cJSON_AddObjectToObject(summary, "refine");
+    cJSON_AddStringToObject(fj, "hessian", "exact (structured finite differences)");
+    cJSON_AddStringToObject(fj, "status", go_solve_status_str(rres.status));
+    cJSON_AddNumberToObject(fj, "iterations", rres.iterations);
+    cJSON_AddNumberToObject(fj, "wall_s", rres.wall_s);
+    cJSON_AddNumberToObject(fj, "objective", rres.objective);
+    cJSON_AddBoolToObject(fj, "used", refined);
+  }
   // Ipopt's own measures at its last iteration (scaled problem; before the polish)
   cJSON* lj = cJSON_AddObjectToObject(summary, "ipopt_last_iteration");
   cJSON_AddNumberToObject(lj, "inf_pr", res.last_inf_pr);

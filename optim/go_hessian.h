@@ -93,8 +93,10 @@ int go_hess_values(go_hess* h, const double* x, double obj_factor, const double*
 // Hessian entries per node, about 1800 path evaluations per node and Hessian, 2-4.4 s per
 // iteration against 0.4 s with L-BFGS; Ipopt takes tiny steps (alpha 1e-3 - 1e-1, mu stays at
 // 0.1) and inf_du grows to 1e5-1e9 within 30 iterations, before and after the tendon fix of
-// mjmodels/README.md rule 3: not yet useful on the full-body problem (its values are right:
-// tests/test_hessian_fd.c). Experimental, like the partitioned quasi-Newton Hessian.
+// mjmodels/README.md rule 3 (its values are right: tests/test_hessian_fd.c). That was Ipopt's
+// monotone barrier from mu 0.1; from an L-BFGS tracking solution with mu 1e-6 and mu-based bound
+// multipliers it reaches Ipopt's acceptable level in 78 iterations (2026-12-02, docs/BENCHMARKS.md),
+// which `gaitsim track --refine` uses after an L-BFGS solve that stops short.
 int go_hess_create_fd(go_hess** out, go_nlp* nlp, const go_elements* el, char* err, int errsz);
 
 // counters: element updates done and skipped (tiny, non-finite or ill-conditioned pairs)

@@ -25,7 +25,7 @@ for n in "${nodes[@]}"; do
   t0=$(date +%s.%N)
   # exit status 3: stopped at the iteration limit (expected)
   "$build"/gaitsim track mjmodels/trials/jw_ngait_og5 --out "$out/n$n" --nodes "$n" --threads 2 \
-    --max-iter "$iters" --no-polish >"$out/stdout$n" 2>"$out/log$n" || [ $? -eq 3 ] ||
+    --max-iter "$iters" --no-polish --refine 0 >"$out/stdout$n" 2>"$out/log$n" || [ $? -eq 3 ] ||
     { echo "bench_track_iteration.sh: N=$n: gaitsim track failed:" >&2; tail -5 "$out/log$n" >&2; exit 1; }
   t1=$(date +%s.%N)
   # wall column at iteration 1 and at the last iteration printed (restoration lines: "4r")

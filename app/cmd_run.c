@@ -18,7 +18,9 @@ static const char* kRunUsage =
     "six-DOF implant knee with surrogate contact,\n"
     "mjmodels/trials/jw_ngait_og5):\n"
     "  1. DIR/track: tracking solve on N nodes (default 20; more nodes are solved on 20 first and\n"
-    "     continued), polished to a dynamically consistent point when it stops short;\n"
+    "     continued): up to 600 L-BFGS iterations; if they stop short, up to 150 Newton\n"
+    "     iterations with the exact Hessian (gaitsim track --refine); polished to a dynamically\n"
+    "     consistent point;\n"
     "  2. DIR/sweep/predict_V: predictive solves at the speeds of LIST (default 0.8,2.0: 0.8 and\n"
     "     2.0 m/s, each started from the tracking solution as in the paper, in two\n"
     "     processes; a longer LIST is solved by continuation, gaitsim sweep), DIR/sweep/sweep.md;\n"
@@ -29,8 +31,9 @@ static const char* kRunUsage =
     "stopped short (its best iterate written), else as the failing step.\n\n"
     "  --max-iter N   Ipopt iteration limit of each predictive solve (default 1500: an iteration\n"
     "                 budget, not a time limit, so that the results do not depend on the load\n"
-    "                 of the machine; the solves measured converged after 477 (0.8 m/s) and 993\n"
-    "                 (2.0 m/s) iterations, 6 and 13 minutes, on 2 cores)\n"
+    "                 of the machine; in the main job of 2026-12-02 they reached Ipopt's\n"
+    "                 acceptable level after 419 (0.8 m/s) and 860 (2.0 m/s) iterations, 7 and\n"
+    "                 12.5 minutes, on 2 cores)\n"
     "  --max-time S   wall-clock limit of each predictive solve, s (default none); the tracking\n"
     "                 solve stops after 600 iterations (1000 on a continued mesh)\n";
 

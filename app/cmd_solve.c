@@ -753,6 +753,25 @@ done:
   return rc;
 }
 
+// Ipopt options for a solve that starts at a point near a solution (the restarts after a
+// fall-back, the exact-Hessian refinement): bound multipliers from a small barrier (z = mu / s,
+// mu 1e-6), so that the barrier update starts small, and the point barely pushed off its bounds
+static int set_start_near_solution(go_ipopt_opts* ro, char* err, int errsz) {
+  static const char* kv[][2] = {{"bound_mult_init_method", "mu-based"}, {"mu_init", "1e-6"},
+                                {"bound_push", "1e-8"}, {"bound_frac", "1e-8"}};
+  for (size_t i = 0; i < sizeof(kv) / sizeof(kv[0]); i++)
+    if (go_ipopt_opts_set(ro, kv[i][0], kv[i][1], err, errsz) != 0) return -1;
+  return 0;
+}
+
+// a solve that continued an earlier one: iterations, the best iterate's index, times add up
+static void continue_result(go_solve_result* later, const go_solve_result* earlier) {
+  later->iterations += earlier->iterations;
+  later->best_iter = later->best_iter >= 0 ? later->best_iter + earlier->iterations : -1;
+  later->wall_s += earlier->wall_s;
+  later->cpu_s += earlier->cpu_s;
+}
+
 static int solve(gsTrackOptions o);
 
 // the "trial" of DIR/summary.json (caller frees), or NULL when absent or unreadable
@@ -1175,15 +1194,11 @@ static int solve(gsTrackOptions o) {
     go_ipopt_opts ro = o.ipopt;
     if (o.max_iter >= 0) ro.max_iter = o.max_iter - res.iterations;
     if (o.max_time > 0) ro.max_wall_s = o.max_time - res.wall_s;
-    static const char* restart_opts[][2] = {{"bound_mult_init_method", "mu-based"},
-                                            {"mu_init", "1e-6"}, {"bound_push", "1e-8"},
-                                            {"bound_frac", "1e-8"}};
-    for (size_t i = 0; i < sizeof(restart_opts) / sizeof(restart_opts[0]); i++)
-      if (go_ipopt_opts_set(&ro, restart_opts[i][0], restart_opts[i][1], err, sizeof(err)) != 0) {
-        fprintf(stderr, "gaitsim: track: restart: %s\n", err);
-        free(lam);
-        goto done;
-      }
+    if (set_start_near_solution(&ro, err, sizeof(err)) != 0) {
+      fprintf(stderr, "gaitsim: track: restart: %s\n", err);
+      free(lam);
+      goto done;
+    }
     memcpy(z, zb, sizeof(double) * (size_t)n);
     go_solve_result r2;
     if (go_ipopt_solve(nlp, &ro, z, zb, lam ? &mult : NULL, &r2, err, sizeof(err)) != 0) {
@@ -1193,10 +1208,7 @@ static int solve(gsTrackOptions o) {
     }
     // the restart's iteration 0 is the best iterate itself (pushed 1e-8 off its bounds), so its
     // best iterate is at least as good; counts and times add up
-    r2.iterations += res.iterations;
-    r2.best_iter = r2.best_iter >= 0 ? r2.best_iter + res.iterations : -1;
-    r2.wall_s += res.wall_s;
-    r2.cpu_s += res.cpu_s;
+    continue_result(&r2, &res);
     res = r2;
     n_restarts++;
   }
@@ -1221,15 +1233,11 @@ static int solve(gsTrackOptions o) {
     // iteration costs about 4 times the N = 20 one)
     ro.max_wall_s = o.max_time > 0 ? fmin(o.max_time - res.wall_s, GS_REFINE_WALL_S)
                                    : GS_REFINE_WALL_S;
-    static const char* refine_opts[][2] = {{"bound_mult_init_method", "mu-based"},
-                                           {"mu_init", "1e-6"}, {"bound_push", "1e-8"},
-                                           {"bound_frac", "1e-8"}};
-    for (size_t i = 0; i < sizeof(refine_opts) / sizeof(refine_opts[0]); i++)
-      if (go_ipopt_opts_set(&ro, refine_opts[i][0], refine_opts[i][1], err, sizeof(err)) != 0) {
-        fprintf(stderr, "gaitsim: track: refine: %s\n", err);
-        free(lam);
-        goto done;
-      }
+    if (set_start_near_solution(&ro, err, sizeof(err)) != 0) {
+      fprintf(stderr, "gaitsim: track: refine: %s\n", err);
+      free(lam);
+      goto done;
+    }
     fprintf(stderr, "%s: %s after %d iterations; exact-Hessian refinement from the best iterate "
             "(iteration %d, objective %.6g, violation %.3g), up to %d iterations\n", what,
             go_solve_status_str(res.status), res.iterations, res.best_iter, res.best_objective,
@@ -1255,10 +1263,7 @@ static int solve(gsTrackOptions o) {
       memcpy(z, zr, sizeof(double) * (size_t)n);
       memcpy(zb, zrb, sizeof(double) * (size_t)n);
       go_solve_result merged = rres;
-      merged.iterations += res.iterations;
-      merged.best_iter = rres.best_iter >= 0 ? rres.best_iter + res.iterations : -1;
-      merged.wall_s += res.wall_s;
-      merged.cpu_s += res.cpu_s;
+      continue_result(&merged, &res);
       res = merged;
     }
     free(zr), free(zrb);

@@ -159,7 +159,7 @@ static void defaults(gsTrackOptions* o) {
   // consecutive iterations. With 1e-6 instead of 1e-4, the predictions at 0.8 and 2.0 m/s went
   // on past their settled objective (within 0.1 % of the lowest ever reached) and, in 2 of 4
   // solves, climbed back 40-50 % when the adaptive barrier fell back to its monotone mode
-  // (docs/BENCHMARKS.md, "The acceptable level at a violation of 1e-4").
+  // (docs/BENCHMARKS.md, "The acceptable level at 1e-4").
   static const char* stop_rule[][2] = {
       {"tol", "1e-4"},          {"constr_viol_tol", "1e-6"},
       {"acceptable_tol", "1"},  {"acceptable_constr_viol_tol", "1e-4"},
@@ -764,6 +764,11 @@ static int set_start_near_solution(go_ipopt_opts* ro, char* err, int errsz) {
   return 0;
 }
 
+// Ipopt's optimal or acceptable level: the project's stopping rule was met
+static int solve_converged(const go_solve_result* r) {
+  return r->status == GO_SOLVE_SUCCESS || r->status == GO_SOLVE_ACCEPTABLE;
+}
+
 // a solve that continued an earlier one: iterations, the best iterate's index, times add up
 static void continue_result(go_solve_result* later, const go_solve_result* earlier) {
   later->iterations += earlier->iterations;
@@ -1174,9 +1179,8 @@ static int solve(gsTrackOptions o) {
   // restarts after a fall-back: Ipopt once came near a solution (violation <= 1e-4) and left it
   // (the adaptive barrier's fixed mode or a restoration phase raised mu by 3-9 decades and the
   // objective by 40-600 %; docs/BENCHMARKS.md, "Fall-backs and restarts"). Start again from the
-  // best iterate with the iterations left, the bound multipliers set from a small barrier
-  // (z = mu / s) so that the adaptive update starts small, and the point barely pushed off its
-  // bounds; at most GS_MAX_RESTARTS times
+  // best iterate with the iterations left (set_start_near_solution); at most GS_MAX_RESTARTS
+  // times
   restarts = cJSON_CreateArray();
   int n_restarts = 0;
   while (res.status == GO_SOLVE_FELL_BACK && res.best_iter >= 0 && n_restarts < GS_MAX_RESTARTS &&
@@ -1219,7 +1223,7 @@ static int solve(gsTrackOptions o) {
   go_solve_result rres;
   int refined = -1;  // -1 not run, 0 run and not used, 1 used
   if (o.refine_iter > 0 && !o.hess_fd && !o.pqn && !o.ipopt.gauss_newton && res.best_iter >= 0 &&
-      res.status != GO_SOLVE_SUCCESS && res.status != GO_SOLVE_ACCEPTABLE &&
+      !solve_converged(&res) &&
       res.status != GO_SOLVE_INTERRUPTED && (o.max_time <= 0 || res.wall_s < o.max_time)) {
     if (go_hess_create_fd(&hess, nlp, go_gait_elements(g), err, sizeof(err)) != 0) {
       fprintf(stderr, "gaitsim: track: refine: %s\n", err);
@@ -1242,35 +1246,28 @@ static int solve(gsTrackOptions o) {
             "(iteration %d, objective %.6g, violation %.3g), up to %d iterations\n", what,
             go_solve_status_str(res.status), res.iterations, res.best_iter, res.best_objective,
             res.best_viol, o.refine_iter);
-    double* zr = (double*)malloc(sizeof(double) * (size_t)n);
-    double* zrb = (double*)malloc(sizeof(double) * (size_t)n);
-    if (!zr || !zrb) {
-      free(zr), free(zrb), free(lam);
-      fprintf(stderr, "gaitsim: track: out of memory (refine)\n");
-      goto done;
-    }
-    memcpy(zr, zb, sizeof(double) * (size_t)n);
-    if (go_ipopt_solve(nlp, &ro, zr, zrb, lam ? &mult : NULL, &rres, err, sizeof(err)) != 0) {
+    // z (Ipopt's point of a solve that stopped short, not used: its output is zb) takes the
+    // refinement's point, zs (scratch until the polish) its best iterate
+    memcpy(z, zb, sizeof(double) * (size_t)n);
+    if (go_ipopt_solve(nlp, &ro, z, zs, lam ? &mult : NULL, &rres, err, sizeof(err)) != 0) {
       fprintf(stderr, "gaitsim: track: refine: %s\n", err);
-      free(zr), free(zrb), free(lam);
+      free(lam);
       goto done;
     }
-    refined = rres.status == GO_SOLVE_SUCCESS || rres.status == GO_SOLVE_ACCEPTABLE;
+    refined = solve_converged(&rres);
     fprintf(stderr, "%s: refinement: %s after %d iterations, %.1f s, objective %.6g%s\n", what,
             go_solve_status_str(rres.status), rres.iterations, rres.wall_s, rres.objective,
             refined ? "" : "; the L-BFGS best iterate stays");
     if (refined) {
-      memcpy(z, zr, sizeof(double) * (size_t)n);
-      memcpy(zb, zrb, sizeof(double) * (size_t)n);
+      memcpy(zb, zs, sizeof(double) * (size_t)n);
       go_solve_result merged = rres;
       continue_result(&merged, &res);
       res = merged;
     }
-    free(zr), free(zrb);
   }
   if (lam) print_largest_multipliers(g, lam, o.predict ? "predict" : "track");
   free(lam);
-  int converged = res.status == GO_SOLVE_SUCCESS || res.status == GO_SOLVE_ACCEPTABLE;
+  int converged = solve_converged(&res);
   double* zout = converged || res.best_iter < 0 ? z : zb;
   // feasibility polish: the dynamically consistent point nearest to the returned point (Ipopt's
   // when it converged, whose acceptable test allows a violation of 1e-4, else the best iterate;
@@ -1309,7 +1306,7 @@ static int solve(gsTrackOptions o) {
       fprintf(stderr, "gaitsim: track: polish: %s\n", err);
       goto done;
     }
-    int pconv = pres.status == GO_SOLVE_SUCCESS || pres.status == GO_SOLVE_ACCEPTABLE;
+    int pconv = solve_converged(&pres);
     const double* zp = pconv || pres.best_iter < 0 ? z : zs;
     double vp = pconv || pres.best_iter < 0 ? pres.max_viol : pres.best_viol;
     if (vp < viol_before) {

@@ -14,6 +14,11 @@ earlier: when its line search fails at a point that passes the test once, Ipopt 
 acceptable level without the consecutive iterations.
 Restoration-phase iterations ("r") break a run of consecutive iterations; the feasibility polish
 that follows a solve (its lines come after "feasibility polish") is left out.
+
+The last column replays gaitsim's fall-back guard (go_ipopt_opts.fallback_rise 0.25, fallback_viol
+1e-4, as `gaitsim track` and `predict` set them): the first iteration outside the restoration phase
+whose objective is more than 25 % above the lowest objective of the earlier such iterations with
+inf_pr <= 1e-4, or "-".
 """
 import re
 import sys
@@ -25,6 +30,7 @@ RULES = [  # (violation, objective change, iterations)
     (3e-5, 1e-4, 10),
     (1e-5, 1e-4, 5),
 ]
+GUARD_RISE, GUARD_VIOL = 0.25, 1e-4
 
 
 def read_log(path):
@@ -51,12 +57,25 @@ def first_stop(rows, viol_tol, obj_tol, n_iter):
     return None
 
 
+def first_fall_back(rows):
+    low = None
+    for it, resto, obj, inf_pr in rows:
+        if resto:
+            continue
+        if low is not None and obj > low + GUARD_RISE * abs(low):
+            return it, obj, low
+        if inf_pr <= GUARD_VIOL and (low is None or obj < low):
+            low = obj
+    return None
+
+
 def main(paths):
     if not paths:
         print(__doc__.strip().splitlines()[2], file=sys.stderr)
         return 2
     print("log | last iteration | lowest J (inf_pr <= 1e-6) | " +
-          " | ".join(f"stop at viol {v:g}, dJ {o:g}, {n} its" for v, o, n in RULES))
+          " | ".join(f"stop at viol {v:g}, dJ {o:g}, {n} its" for v, o, n in RULES) +
+          f" | guard: {GUARD_RISE * 100:g} % above the lowest J at viol <= {GUARD_VIOL:g}")
     for path in paths:
         try:
             rows = read_log(path)
@@ -73,6 +92,8 @@ def main(paths):
             hit = first_stop(rows, *rule)
             cells.append("-" if hit is None else
                          f"{hit[0]} ({(hit[1] / jmin - 1) * 100:+.2f} %)" if feasible else f"{hit[0]}")
+        fell = first_fall_back(rows)
+        cells.append("-" if fell is None else f"{fell[0]} ({fell[1]:.4g} against {fell[2]:.4g})")
         print(f"{path} | {rows[-1][0]} | {jmin:.4f} | " + " | ".join(cells))
     return 0
 

@@ -103,6 +103,9 @@ typedef struct {
   const char* guess;   // predict: solution folder to start from (the tracking solution)
   double speed;        // predict: prescribed mean speed (m/s)
   double metabolic_smoothing;  // predict: factor on the smooth Umberger widths (-), 1
+  double min_vgrf;     // predict: floor on the summed vertical ground reaction of both feet at
+                       // every node (BW; go_gait_opts.min_vgrf), 0: none
+  double stride_time;  // predict: > 0: the stride time held at this value (s), 0: free
 } gsTrackOptions;
 
 // --weight NAME=VALUE
@@ -625,9 +628,9 @@ done:
 }
 
 // constraint blocks of the gait NLP, for the diagnostic lines
-enum { BLOCKS = 8 };
-static const char* kBlockNames[BLOCKS] = {"defect", "link", "eom",      "hill",
-                                          "act",    "grf",  "boundary", "fibre"};
+enum { BLOCKS = 9 };
+static const char* kBlockNames[BLOCKS] = {"defect", "link",  "eom", "hill", "act",
+                                          "grf",    "boundary", "fibre", "walk"};
 
 // block of constraint row r, its index within the node (state, path row, boundary row) and node
 static int block_of_row(go_gait* g, int r, int* idx, int* node) {
@@ -644,6 +647,7 @@ static int block_of_row(go_gait* g, int r, int* idx, int* node) {
   }
   int pr = (r - p0) % L->n_path;
   *idx = pr, *node = (r - p0) / L->n_path;
+  if (L->r_walk >= 0 && pr == L->r_walk) return 8;
   if (L->r_fib >= 0 && pr >= L->r_fib) return 7;
   return pr < L->r_eom ? 1 : pr < L->r_hill ? 2 : pr < L->r_act ? 3 : pr < L->r_grf ? 4 : 5;
 }
@@ -657,7 +661,9 @@ static void print_block_max(go_gait* g, const double* v, int mm, const char* wha
     if (v[r] > mx[blk]) mx[blk] = v[r], at[blk] = idx, node[blk] = k;
   }
   fprintf(stderr, "%s by block:", what);
-  for (int b = 0; b < (go_gait_layout_get(g)->r_fib >= 0 ? BLOCKS : BLOCKS - 1); b++) {
+  const go_gait_layout* L = go_gait_layout_get(g);
+  for (int b = 0; b < BLOCKS; b++) {
+    if ((b == 7 && L->r_fib < 0) || (b == 8 && L->r_walk < 0)) continue;  // rows not in the NLP
     if (with_node) fprintf(stderr, " %s %.3g (#%d node %d)", kBlockNames[b], mx[b], at[b], node[b]);
     else fprintf(stderr, " %s %.3g (#%d)", kBlockNames[b], mx[b], at[b]);
   }
@@ -811,6 +817,13 @@ static char* trial_of_solution(const char* dir) {
 // same tracking solution, and the exact (unsmoothed) cost of transport of the solution differs by
 // 1.8 % (docs/BENCHMARKS.md, 2026-12-02); 3 times wider did not converge in 1000 at 0.8 m/s
 #define PREDICT_METABOLIC_SMOOTHING 10.0
+// predict's floor on the summed vertical ground reaction of both feet at every node (BW): no
+// flight phase. Not in the paper; without it, 20-node solves at 2.0 m/s found a gait with 2 of
+// 20 nodes in flight (2.5 BW peaks) and a bouncing one with flight at 3 nodes and a 75 % longer
+// stride, cheaper than the walks; with it the same guess gave a walk (double support at 2 nodes,
+// lowest summed force 0.22 BW). Human walking keeps it above about 0.4 BW even at 2 m/s
+// (docs/BENCHMARKS.md, "Walking: a floor on the vertical ground reaction")
+#define PREDICT_MIN_VGRF 0.2
 static int predict_setup(const mjModel* m, gsTrackOptions* o, go_gait_opts* go, double** band,
                          double* T0, double* dx0) {
   gsTable states, controls;
@@ -861,11 +874,13 @@ static int predict_setup(const mjModel* m, gsTrackOptions* o, go_gait_opts* go, 
   go->free_time = 1;
   go->T_lb = 0.4;
   go->T_ub = 2.5;
+  if (o->stride_time > 0) go->T_lb = go->T_ub = o->stride_time;  // Ipopt fixes the variable
   go->band_z = *band;
   go->band_q = bq;
   go->band_qd = bqd;
   // eq. 2's fibre-length bounds (go_gait_opts.fibre_bounds); how far the guess is outside them
   go->fibre_bounds = o->fibre_bounds;
+  go->min_vgrf = o->min_vgrf;
   {
     mjData* d = mj_makeData(go_gait_model(tmp));
     double* lm = (double*)malloc(sizeof(double) * (size_t)L->na);
@@ -917,6 +932,10 @@ static void retime_progression(const go_gait* g, double* z, double V, double T0)
   z[(size_t)N * nz] = T0;
 }
 
+// a foot is on the ground when it bears at least this vertical force (BW): 0.02 BW, about 12 N
+// for JW, below the 20 N threshold of force-plate event detection
+#define GAIT_CONTACT_BW 0.02
+
 // prediction figures for summary.json: speed, stride time and length and their change from the
 // guess, cost of transport, share of the regularisation, peak triceps surae excitations
 static void predict_summary(const go_gait* g, const double* z, const gsTrackOptions* o, double T0,
@@ -936,6 +955,22 @@ static void predict_summary(const go_gait* g, const double* z, const gsTrackOpti
   cJSON_AddNumberToObject(summary, "cost_of_transport_j_per_kg_m", cot);
   cJSON_AddNumberToObject(summary, "regularisation_share", objective > 0 ? 1 - cot / objective : NAN);
   cJSON_AddNumberToObject(summary, "metabolic_smoothing", o->metabolic_smoothing);
+  // walk or run: the summed vertical ground reaction's minimum over the nodes, the nodes where no
+  // foot bears GAIT_CONTACT_BW and those where both do (double support); the floor asked for
+  double bw = go_gait_weight(g), vmin = INFINITY;
+  int flight = 0, dsupport = 0;
+  for (int k = 0; k < N; k++) {
+    const double* f = z + (size_t)k * L->nz + L->u_grf;
+    vmin = fmin(vmin, (f[2] + f[5]) / bw);
+    flight += f[2] < GAIT_CONTACT_BW * bw && f[5] < GAIT_CONTACT_BW * bw;
+    dsupport += f[2] >= GAIT_CONTACT_BW * bw && f[5] >= GAIT_CONTACT_BW * bw;
+  }
+  cJSON_AddNumberToObject(summary, "min_vgrf_bound_bw", o->min_vgrf);
+  if (o->stride_time > 0) cJSON_AddNumberToObject(summary, "stride_time_fixed_s", o->stride_time);
+  else cJSON_AddNullToObject(summary, "stride_time_fixed_s");
+  cJSON_AddNumberToObject(summary, "min_summed_vgrf_bw", vmin);
+  cJSON_AddNumberToObject(summary, "flight_nodes", flight);
+  cJSON_AddNumberToObject(summary, "double_support_nodes", dsupport);
   static const char* peaks[] = {"soleus", "gasmed", "gaslat", "soleus_l", "med_gas_l", "lat_gas_l"};
   cJSON* pk = cJSON_AddObjectToObject(summary, "peak_excitation");
   for (size_t q = 0; q < sizeof(peaks) / sizeof(peaks[0]); q++) {
@@ -969,6 +1004,12 @@ static const char* kPredictUsage =
     "  --no-fibre-bounds   no path bounds 0.25 <= lM/lopt <= 1.5 on every muscle's normalised\n"
     "                      fibre length (Lin, Walter & Pandy 2018, eq. 2; on by default; the\n"
     "                      guess's count outside them is printed)\n"
+    "  --min-vgrf F        walking: the summed vertical ground reaction of both feet at least F\n"
+    "                      body weights at every node, so no node is in flight (not in the\n"
+    "                      paper; default 0.2, 0 turns it off; summary.json min_summed_vgrf_bw,\n"
+    "                      flight_nodes, double_support_nodes tell a walk from a run)\n"
+    "  --stride-time S     hold the stride time at S seconds (0.4-2.5) instead of leaving it\n"
+    "                      free: the cost of transport at a prescribed cadence\n"
     "  --metabolic-smoothing F  factor on every width of the smooth Umberger 2010 rates\n"
     "                      (steps in u - a, lM~ - 1 and v~, the maxima and minima; widths of\n"
     "                      gs_metabolics.h times F; default 10: steps 0.1 wide, which lets the\n"
@@ -990,7 +1031,9 @@ int gs_cmd_predict(int argc, char** argv) {
       {"ipopt", required_argument, NULL, 'p'},    {"help", no_argument, NULL, 'h'},
       {"no-fibre-bounds", no_argument, NULL, 'F'},
       {"metabolic-smoothing", required_argument, NULL, 'S'},
-      {"fallback-rise", required_argument, NULL, 'R'},        {NULL, 0, NULL, 0}};
+      {"fallback-rise", required_argument, NULL, 'R'},
+      {"min-vgrf", required_argument, NULL, 'W'},
+      {"stride-time", required_argument, NULL, 'D'},          {NULL, 0, NULL, 0}};
   gsTrackOptions o;
   defaults(&o);
   o.predict = 1;
@@ -1000,10 +1043,11 @@ int gs_cmd_predict(int argc, char** argv) {
   o.w_accel = PREDICT_W_ACCEL;
   o.metabolic_smoothing = PREDICT_METABOLIC_SMOOTHING;
   o.fibre_bounds = 1;
+  o.min_vgrf = PREDICT_MIN_VGRF;
   optind = 1;
   int c, bad = 0, model_given = 0;
   char err[256], *end;
-  while ((c = getopt_long(argc, argv, "g:s:o:m:n:t:i:T:w:PFS:R:p:h", options, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, "g:s:o:m:n:t:i:T:w:PFS:R:W:D:p:h", options, NULL)) != -1) {
     switch (c) {
       case 'g': o.guess = optarg; break;
       case 's':
@@ -1025,6 +1069,14 @@ int gs_cmd_predict(int argc, char** argv) {
       case 'w': bad |= parse_weight(optarg, &o); break;
       case 'P': o.polish = 0; break;
       case 'F': o.fibre_bounds = 0; break;
+      case 'D':
+        o.stride_time = strtod(optarg, &end);
+        bad |= *end || end == optarg || !(o.stride_time >= 0.4 && o.stride_time <= 2.5);
+        break;
+      case 'W':
+        o.min_vgrf = strtod(optarg, &end);
+        bad |= *end || end == optarg || !(o.min_vgrf >= 0 && o.min_vgrf < 10);
+        break;
       case 'R':
         o.ipopt.fallback_rise = strtod(optarg, &end);
         bad |= *end || end == optarg || !(o.ipopt.fallback_rise >= 0);
@@ -1132,7 +1184,7 @@ static int solve(gsTrackOptions o) {
   gv = (double*)malloc(sizeof(double) * (size_t)mm);
   if (o.predict) {
     memcpy(z, band, sizeof(double) * (size_t)n);
-    retime_progression(g, z, o.speed, T0);
+    retime_progression(g, z, o.speed, o.stride_time > 0 ? o.stride_time : T0);
   } else if (o.init) {
     int from_vars = guess_from_variables(g, o.init, z);
     if (from_vars < 0 || (from_vars == 0 && guess_from_folder(g, m, o.init, o.activation, z) != 0))

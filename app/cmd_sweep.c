@@ -214,21 +214,24 @@ int gs_cmd_sweep(int argc, char** argv) {
                     "stride_time_change_pct,stride_length_change_pct,"
                     "cost_of_transport_j_per_kg_m,peak_vertical_grf_bw,peak_knee_contact_r_bw,"
                     "peak_knee_contact_l_bw,peak_soleus_excitation,peak_gastrocnemius_excitation,"
-                    "status\n");
+                    "min_summed_vgrf_bw,flight_nodes,double_support_nodes,status\n");
   int lm = snprintf(md, sizeof(md), "| speed (m/s) | stride time (s) | stride length (m) | "
                     "change from the guess: time, length (%%) | cost of transport (J/(kg m)) | "
                     "peak vertical GRF (BW) | peak knee contact, right (BW) | peak knee contact, "
-                    "left (BW) | peak excitation: soleus, gastrocnemius | status |\n"
-                    "|---|---|---|---|---|---|---|---|---|---|\n");
+                    "left (BW) | peak excitation: soleus, gastrocnemius | lowest summed vertical "
+                    "GRF (BW); nodes in flight, in double support | status |\n"
+                    "|---|---|---|---|---|---|---|---|---|---|---|\n");
   double sol_ex[SWEEP_MAX_SPEEDS], gas_ex[SWEEP_MAX_SPEEDS];
   for (int i = 0; i < n; i++) {
     snprintf(sol, sizeof(sol), "%s/predict_%.4g", dir, v[i]);
     snprintf(path, sizeof(path), "%s/summary.json", sol);
     cJSON* j = gs_app_read_json(path);
-    const char* keys[4] = {"stride_time_s", "stride_length_m", "cost_of_transport_j_per_kg_m",
-                           "body_weight_n"};
-    double f[4];
-    for (int q = 0; q < 4; q++) {
+    // walk or run: summary.json's lowest summed vertical force and flight, double-support nodes
+    const char* keys[7] = {"stride_time_s", "stride_length_m", "cost_of_transport_j_per_kg_m",
+                           "body_weight_n", "min_summed_vgrf_bw", "flight_nodes",
+                           "double_support_nodes"};
+    double f[7];
+    for (int q = 0; q < 7; q++) {
       const cJSON* x = cJSON_GetObjectItemCaseSensitive(j, keys[q]);
       f[q] = cJSON_IsNumber(x) ? x->valuedouble : NAN;
     }
@@ -250,14 +253,15 @@ int gs_cmd_sweep(int argc, char** argv) {
     double dT = 100 * (f[0] / T0 - 1), dL = 100 * (f[1] / L0 - 1);
     if (lc < (int)sizeof(csv))
       lc += snprintf(csv + lc, sizeof(csv) - (size_t)lc,
-                     "%.4g,%.4f,%.4f,%.2f,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%s\n", v[i], f[0], f[1],
-                     dT, dL, f[2], grf, knee, knee_l, sol_ex[i], gas_ex[i], status);
+                     "%.4g,%.4f,%.4f,%.2f,%.2f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.3f,%.0f,%.0f,%s\n",
+                     v[i], f[0], f[1], dT, dL, f[2], grf, knee, knee_l, sol_ex[i], gas_ex[i], f[4],
+                     f[5], f[6], status);
     if (lm < (int)sizeof(md))
       lm += snprintf(md + lm, sizeof(md) - (size_t)lm,
                      "| %.4g | %.3f | %.3f | %+.1f, %+.1f | %.2f | %.2f | %.2f | %.2f | %.2f, %.2f "
-                     "| %s |\n",
-                     v[i], f[0], f[1], dT, dL, f[2], grf, knee, knee_l, sol_ex[i], gas_ex[i],
-                     status);
+                     "| %.2f; %.0f, %.0f | %s |\n",
+                     v[i], f[0], f[1], dT, dL, f[2], grf, knee, knee_l, sol_ex[i], gas_ex[i], f[4],
+                     f[5], f[6], status);
     cJSON_Delete(j);
   }
   // Lin, Walter & Pandy 2018 report peak soleus and gastrocnemius excitations about 2.5 times

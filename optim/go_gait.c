@@ -71,8 +71,9 @@ struct go_gait {
   double grf_wt[GO_GAIT_NGRF]; // per grf component: its goal weight / scale^2 / GO_GAIT_NGRF
   double w_effort;            // effort weight / na
   double w_accel;             // acceleration weight / GO_GAIT_ACCEL_SCALE^2 / nv  (s^4, s^4/m^2)
-  double* path_lb;            // path row bounds, physical (n_path): 0, fibre rows fibre_lo
-  double* path_ub;            // (n_path): 0, fibre rows fibre_hi
+  double* path_lb;            // path row bounds, physical (n_path): 0, fibre rows fibre_lo,
+                              // walk row min_vgrf m g
+  double* path_ub;            // (n_path): 0, fibre rows fibre_hi, walk row none (1e19)
   int* ivars;                 // integrand variables
   int n_ivars;
   double cot_scale;           // w_cot / (m V): metabolic integrand factor      (s / (kg m))
@@ -223,6 +224,8 @@ int go_gait_path_eval(const go_gait* g, mjData* d, const double* z, double* res)
   for (int i = 0; L->r_fib >= 0 && i < L->na; i++) {
     res[L->r_fib + i] = fibre_norm(g, d, z, i, NULL);
   }
+  // summed vertical ground reaction (bounded below by path_lb: no flight phase)
+  if (L->r_walk >= 0) res[L->r_walk] = z[L->u_grf + 2] + z[L->u_grf + 5];
   for (int r = 0; r < L->n_path; r++) {
     if (!isfinite(res[r])) {
       return -1;
@@ -305,8 +308,8 @@ static int path_jac_cb(void* vctx, int k, const double* z, double* vals) {
       double ddu = 0;
       gs_activation_dot(&g->aprm[i], z[col], z[L->x_a + i], &ddu, NULL);
       vals[p0] = -ddu;
-    } else {  // grf variable
-      vals[p0] = 1.0;
+    } else {  // grf variable: its grf row and, vertical forces, the walk row
+      for (int p = p0; p < p1; p++) vals[p] = 1.0;
     }
   }
   for (int col = 0; col < L->nz; col++) {
@@ -616,6 +619,8 @@ static int pattern(const go_gait* g, int* col_ptr, int* row_idx) {
       PUT(L->r_act + col - L->u_e);
     } else {  // grf
       PUT(L->r_grf + col - L->u_grf);
+      int c = col - L->u_grf;
+      if (L->r_walk >= 0 && (c == 2 || c == 5)) PUT(L->r_walk);  // vertical forces
     }
   }
   if (col_ptr) col_ptr[L->nz] = n;
@@ -897,9 +902,9 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   g->nthreads = o->nthreads;
   g->free_time = o->free_time;
   if (na > GO_GAIT_MAX_MUSCLES || (o->w_cot > 0 && !(g->speed > 0)) ||
-      (o->free_time && !(o->T_lb > 0 && o->T_ub > o->T_lb))) {
+      (o->free_time && !(o->T_lb > 0 && o->T_ub >= o->T_lb))) {
     snprintf(err, errsz, "go_gait_create: at most %d muscles; a cost-of-transport goal needs a "
-             "speed; free time needs 0 < T_lb < T_ub", GO_GAIT_MAX_MUSCLES);
+             "speed; free time needs 0 < T_lb <= T_ub (equal: Ipopt fixes T)", GO_GAIT_MAX_MUSCLES);
     go_gait_free(g);
     return -1;
   }
@@ -982,6 +987,16 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
     }
     L->r_fib = L->n_path;
     L->n_path += na;
+  }
+  L->r_walk = -1;
+  if (o->min_vgrf > 0) {
+    if (!(o->min_vgrf < 10)) {
+      snprintf(err, errsz, "go_gait_create: min_vgrf must be below 10 body weights");
+      go_gait_free(g);
+      return -1;
+    }
+    L->r_walk = L->n_path;
+    L->n_path += 1;
   }
   L->elastic = g->elastic;
   L->elastic_of = g->elastic_of;
@@ -1145,6 +1160,11 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
     g->path_scale[L->r_fib + i] = 1;  // lM / lopt: O(1)
     g->path_lb[L->r_fib + i] = o->fibre_lo;
     g->path_ub[L->r_fib + i] = o->fibre_hi;
+  }
+  if (L->r_walk >= 0) {
+    g->path_scale[L->r_walk] = g->weight;
+    g->path_lb[L->r_walk] = o->min_vgrf * g->weight;
+    g->path_ub[L->r_walk] = 1e19;  // none (scale_bound: Ipopt's infinity)
   }
 
   // boundary: periodic states (but pelvis_tx and free coordinates), excitations, speed

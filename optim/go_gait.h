@@ -15,7 +15,8 @@
 // the others and is exact since the row is linear). We chose these rows over a deriv_idx map in
 // the engine because the engine is done and tested; they cost nv rows and 2 nv nonzeros per node.
 //
-// Path rows per node, [link (nv) | eom (nv) | hill (ne) | act (na) | grf (6|12) | fibre (na)?]:
+// Path rows per node,
+//   [link (nv) | eom (nv) | hill (ne) | act (na) | grf (6|12) | fibre (na)? | walk (1)?]:
 //   link  qdot - q'                                                        (rad/s, m/s)
 //   eom   mj_inverse(q, qdot, qddot).qfrc_inverse + actuator_moment^T tension    (N m, N)
 //         (qfrc_inverse runs mjcb_passive: the foot contact; all nv rows, pelvis included: no
@@ -32,6 +33,10 @@
 //         length): lM = gs_muscle_fibre_length(lMT(q), lT) with lT = lts
 //         gs_muscle_ft_inverse(fT) for an elastic tendon, lT = lts for a rigid one          (-)
 //         Inequalities; off for tracking, on in `gaitsim predict` (--no-fibre-bounds).
+//   walk  (only with opts.min_vgrf > 0) grf_r,z + grf_l,z >= min_vgrf m g: the summed vertical
+//         ground reaction of both feet at every node, an inequality that rules out flight
+//         phases, so the predicted gait is a walk (a definition of walking, not in the paper;
+//         `gaitsim predict --min-vgrf`)                                                   (N)
 // Tension: elastic Fmax fT; rigid gs_muscle_rigid_force(a, lMT, vMT).
 //
 // Derivatives: analytic columns q' (-1), qddot (mass matrix M from mj_fullM after mj_inverse),
@@ -49,7 +54,7 @@
 //
 // Scaling (Ipopt sees O(1)): q 1, qdot and q' 5, qddot 50, a and e 1, adot 20, fT 1, fT' 10,
 // grf m g (forces) and m g * 1 m (moments); rows: link 5, eom m g * 1 m (N m; N for slides), hill 1,
-// act 20, grf as their variables; periodicity
+// act 20, grf as their variables, walk m g; periodicity
 // fibre 1 (lM / lopt is O(1)); rows as their variable, speed row 1 m/s; objective 1.
 //
 // Objective J = I / T, I = trapezoidal integral of (means over each group of terms)
@@ -121,13 +126,15 @@ typedef struct {
   double w_cot;                     // > 0: cost-of-transport goal weight: the integrand gains
                                     // w_cot Edot / (m g V) ... see go_gait_cot             (-)
   int free_time;                    // 1: stride time T is a variable in [T_lb, T_ub]
-  double T_lb, T_ub;                // bounds of T (s)
+  double T_lb, T_ub;                // bounds of T (s); equal: T held fixed (Ipopt fixes it)
   const double* band_z;             // NULL, or node variables (N nz, physical) of the solution
                                     // the band of eq. 3 is centred on (the tracking solution)
   const double* band_q;             // half-width per dof of the coordinate band (nv; <= 0: none)
   const double* band_qd;            // half-width per dof of the speed band (nv; <= 0: none)
   int fibre_bounds;                 // 1: fibre path rows fibre_lo <= lM/lopt <= fibre_hi (eq. 2)
   double fibre_lo, fibre_hi;        // bounds of the normalised fibre length lM / lopt     (-)
+  double min_vgrf;                  // > 0: the walk row, summed vertical ground reaction of
+                                    // both feet >= min_vgrf m g at every node; 0: none (BW)
   double metabolic_smoothing;       // factor on every width of gs_umberger_smoothing_default
                                     // (the smooth steps and max/min of the cost; eps_a kept) (-)
 } go_gait_opts;
@@ -147,6 +154,7 @@ typedef struct {
                                    // with w_grm > 0, GO_GAIT_NGRF (forces and moments)
   int r_link, r_eom, r_hill, r_act, r_grf;  // offsets of the path row blocks
   int r_fib;                       // offset of the fibre rows (na), -1 without fibre bounds
+  int r_walk;                      // the walk row (1), -1 without min_vgrf
   const int* elastic;              // actuator of elastic muscle e (ne)
   const int* elastic_of;           // elastic index of actuator i, -1 if rigid (na)
   int tx;                          // dof of pelvis_tx, -1 if none
@@ -157,7 +165,7 @@ typedef struct go_gait go_gait;
 // defaults: N 40, 1 thread, T from coords, w_pelvis_rot 1, w_pelvis_trans 1, w_joint 1, w_grf 1,
 // w_grm 0,
 // w_effort 0.1, w_accel 0, periodic 1, no free coordinates, no speed constraint; no prediction
-// (w_cot 0, fixed time, no band, no fibre bounds; fibre_lo 0.25, fibre_hi 1.5)
+// (w_cot 0, fixed time, no band, no fibre bounds; fibre_lo 0.25, fibre_hi 1.5; min_vgrf 0)
 void go_gait_opts_default(go_gait_opts* opts);
 
 // Build the problem for model m (prepared by gs_physics_prepare; every actuator must be a gaitsim

@@ -34,13 +34,15 @@ static double now(void) {
 #define W_ACCEL 2.0
 #define W_GRM 1.5
 
-// extras: the acceleration goal and the fibre-length rows
+// extras: the acceleration goal, the fibre-length rows and the walk row (floor MIN_VGRF BW)
+#define MIN_VGRF 0.1
 static go_gait* make(const mjModel* m, const gsTable* coords, const gsTable* grf, int nthreads,
                      int extras) {
   go_gait_opts o = gs_test_tracking_opts(coords, grf, 4);
   o.w_accel = extras ? W_ACCEL : 0;
   o.w_grm = extras ? W_GRM : 0;
   o.fibre_bounds = extras;
+  o.min_vgrf = extras ? MIN_VGRF : 0;
   o.nthreads = nthreads;
   o.speed = 1.27;
   return gs_test_gait_create(m, &o);
@@ -65,7 +67,8 @@ int main(void) {
   // the fibre rows: na more rows per node, after the grf rows, nonzero only in q columns and
   // the muscle's own fT column (which every elastic muscle's row has)
   {
-    int n0, m0, ne0, bad_col = 0, ft_cols = 0, fib_nnz = 0, grm_nnz = 0;
+    int n0, m0, ne0, bad_col = 0, ft_cols = 0, fib_nnz = 0, grm_nnz = 0, walk_nnz = 0;
+    int walk_bad = 0;
     go_nlp_sizes(go_gait_nlp(g0), &n0, &m0, &ne0);
     // g1 also tracks the ground reaction moments: 6 more variables and rows per node
     int dgrf = GO_GAIT_NGRF - GO_GAIT_GRM_OFFSET;
@@ -73,9 +76,11 @@ int main(void) {
     EXPECT_EQ_INT(GO_GAIT_NGRF, L->ngrf);
     EXPECT_EQ_INT(-1, L0->r_fib);
     EXPECT_EQ_INT(L0->n_path + dgrf, L->r_fib);
-    EXPECT_EQ_INT(L0->n_path + dgrf + L->na, L->n_path);
+    EXPECT_EQ_INT(-1, L0->r_walk);
+    EXPECT_EQ_INT(L0->n_path + dgrf + L->na, L->r_walk);  // the walk row last
+    EXPECT_EQ_INT(L0->n_path + dgrf + L->na + 1, L->n_path);
     EXPECT_EQ_INT(n0 + 4 * dgrf, n);
-    EXPECT_EQ_INT(m0 + 4 * (L->na + dgrf), mm);
+    EXPECT_EQ_INT(m0 + 4 * (L->na + dgrf + 1), mm);
     int* ir0 = malloc(sizeof(int) * (size_t)ne);
     int* jc0 = malloc(sizeof(int) * (size_t)ne);
     go_nlp_jac_structure(a, ir0, jc0);
@@ -84,6 +89,12 @@ int main(void) {
       if (row >= 0 && row < 4 * L->n_path && row % L->n_path >= L->r_grf + GO_GAIT_GRM_OFFSET &&
           row % L->n_path < L->r_grf + L->ngrf)
         grm_nnz++;  // same pattern as the force rows: q, qdot on the path to the foot, own var
+      if (row >= 0 && row < 4 * L->n_path && row % L->n_path == L->r_walk) {
+        int v = jc0[e] % L->nz;  // the two vertical forces of its own node only
+        walk_nnz++;
+        walk_bad += (v != L->u_grf + 2 && v != L->u_grf + 5) || jc0[e] / L->nz != row / L->n_path;
+        continue;
+      }
       if (row < 0 || row >= 4 * L->n_path || row % L->n_path < L->r_fib) continue;
       int i = row % L->n_path - L->r_fib, v = jc0[e] % L->nz;
       fib_nnz++;
@@ -92,7 +103,9 @@ int main(void) {
     }
     EXPECT_EQ_INT(0, bad_col);
     EXPECT_EQ_INT(4 * L->ne, ft_cols);
-    EXPECT_EQ_INT(ne0 + fib_nnz + grm_nnz, ne);
+    EXPECT_EQ_INT(4 * 2, walk_nnz);
+    EXPECT_EQ_INT(0, walk_bad);
+    EXPECT_EQ_INT(ne0 + fib_nnz + grm_nnz + walk_nnz, ne);
     EXPECT_TRUE(grm_nnz > 0);
     printf("fibre rows: %d muscles (%d elastic), %d nonzeros per node\n", L->na, L->ne,
            fib_nnz / 4);
@@ -121,6 +134,23 @@ int main(void) {
   EXPECT_NEAR(0, link, 1e-12);
   EXPECT_NEAR(0, grfr, 1e-12);
   EXPECT_NEAR(0, act, 1e-12);
+  // the walk row is the summed vertical force of both feet, scaled by m g, bounded below by
+  // MIN_VGRF (scaled: MIN_VGRF) and not above
+  {
+    double worst_walk = 0, bw = go_gait_weight(g1);
+    double* gl = malloc(sizeof(double) * (size_t)mm);
+    double* gu = malloc(sizeof(double) * (size_t)mm);
+    go_nlp_bounds(a, NULL, NULL, gl, gu);
+    for (int k = 0; k < 4; k++) {
+      const double* zk = z + (size_t)k * L->nz;
+      int r = go_nlp_row_path(a, k, L->r_walk);
+      worst_walk = fmax(worst_walk, fabs(g[r] - (zk[L->u_grf + 2] + zk[L->u_grf + 5]) / bw));
+      EXPECT_NEAR(MIN_VGRF, gl[r], 1e-15);
+      EXPECT_TRUE(gu[r] >= 1e19);
+    }
+    EXPECT_NEAR(0, worst_walk, 1e-15);
+    free(gl), free(gu);
+  }
   // the moment reference about the world origin gives back the measured centre of pressure on
   // the floor (z = 0): x = -M_y / F_z, y = M_x / F_z (world; OpenSim px and -pz) where loaded
   {
@@ -221,7 +251,8 @@ int main(void) {
     double tol = fabs(ex) > 1e-6 ? 1e-4 : 1e-7;
     if (fabs(ex) > 1e-6 && rel > worst) worst = rel;
     int prow = ir[e] - go_nlp_row_path(a, 0, 0);
-    if (prow >= 0 && prow < 4 * L->n_path && prow % L->n_path >= L->r_fib) {
+    if (prow >= 0 && prow < 4 * L->n_path && prow % L->n_path >= L->r_fib &&
+        prow % L->n_path < L->r_fib + L->na) {
       n_fib++;
       if (fabs(ex) > 1e-6 && rel > worst_fib) worst_fib = rel;
     }

@@ -8,6 +8,7 @@
 # predict continues on the model the guess's summary.json names (here the placeholder-knee
 # jw_fullbody.xml), else on the bundled default (jw_fullbody_knee6.xml). A 5-node tracking
 # summary's coordinate_errors agree with its joint RMS; the knee compartments' RMS are there.
+# The walk row (--min-vgrf, default 0.2 BW; 0 removes it); --stride-time holds the stride time.
 # usage: predict_goals.sh GAITSIM SOURCE_DIR
 set -u
 gaitsim=$1 src=$2
@@ -58,6 +59,50 @@ check "predict continues on the guess's model" /usr/bin/python3 -c "import json,
 sys.exit(0 if json.load(open('from_named/summary.json'))['model'].endswith('/jw_fullbody.xml') else 1)"
 check "without a named model: the bundled knee6 model" /usr/bin/python3 -c "import json,sys; \
 sys.exit(0 if json.load(open('on/summary.json'))['model'].endswith('/jw_fullbody_knee6.xml') else 1)"
+
+# the walk row (--min-vgrf, on by default): one constraint per node, a walk block in the violation lines,
+# and summary.json's summed vertical force minimum equal to the written grf.mot's (Y up, over
+# the mass times gravity); --stride-time holds T: the written stride and the retimed progression
+"$gaitsim" predict --guess "$guess" --speed 0.8 --out walk --nodes 5 --max-iter 0 --no-polish \
+  --threads 1 --min-vgrf 0.2 --stride-time 1.3 >/dev/null 2>walk.txt
+status=$?
+check "--min-vgrf --stride-time: exit 3 at 0 iterations (got $status)" test "$status" -eq 3
+"$gaitsim" predict --guess "$guess" --speed 0.8 --out nowalk --nodes 5 --max-iter 0 --no-polish \
+  --threads 1 --min-vgrf 0 >/dev/null 2>nowalk.txt
+c3=$(sed -n 's/.*variables, \([0-9]*\) constraints.*/\1/p' nowalk.txt)
+check "default floor 0.2 BW: 5 more constraints than --min-vgrf 0 (${c1:-?} vs ${c3:-?})" \
+  test "$((${c1:-0} - ${c3:-0}))" -eq 5
+check "walk block in the violation lines" grep -q "initial violation by block:.* walk " walk.txt
+check "no walk block with --min-vgrf 0" bash -c "! grep -q ' walk ' nowalk.txt"
+check "summary: the floor, the summed vertical force against grf.mot, T held" \
+  /usr/bin/python3 - walk "$src/mjmodels/jw_fullbody_knee6.xml" <<'PY'
+import json, sys, xml.etree.ElementTree as ET
+d = sys.argv[1]
+s = json.load(open(d + "/summary.json"))
+lines = open(d + "/grf.mot").read().split("endheader\n")[1].split("\n")
+head = lines[0].split("\t")
+rows = [list(map(float, l.split("\t"))) for l in lines[1:] if l.strip()]
+ry, ly = head.index("ground_force_r_vy"), head.index("ground_force_l_vy")
+mass = sum(float(b.get("mass", 0)) for b in ET.parse(sys.argv[2]).iter("inertial"))
+bw = mass * 9.81
+vmin = min((r[ry] + r[ly]) / bw for r in rows)
+flight = sum(r[ry] < 0.02 * bw and r[ly] < 0.02 * bw for r in rows)
+ok = (s["min_vgrf_bound_bw"] == 0.2 and abs(s["min_summed_vgrf_bw"] - vmin) < 2e-3
+      and s["flight_nodes"] == flight and len(rows) == 5 and s["double_support_nodes"] >= 0
+      and s["stride_time_fixed_s"] == 1.3 and abs(s["stride_time_s"] - 1.3) < 1e-12
+      and abs(s["stride_length_m"] - 0.8 * 1.3) < 1e-9)
+if not ok:
+    print(json.dumps({k: s.get(k) for k in ("min_vgrf_bound_bw", "min_summed_vgrf_bw",
+          "flight_nodes", "stride_time_s", "stride_length_m", "stride_time_fixed_s")},
+          ), "grf.mot", vmin, flight, mass, file=sys.stderr)
+sys.exit(0 if ok else 1)
+PY
+check "free stride time: stride_time_fixed_s null" /usr/bin/python3 -c "import json,sys; \
+sys.exit(0 if json.load(open('on/summary.json'))['stride_time_fixed_s'] is None else 1)"
+"$gaitsim" predict --guess "$guess" --speed 0.8 --out x --min-vgrf -1 >/dev/null 2>&1
+check "predict --min-vgrf -1: usage, exit 2" test $? -eq 2
+"$gaitsim" predict --guess "$guess" --speed 0.8 --out x --stride-time 3 >/dev/null 2>&1
+check "predict --stride-time 3 (outside 0.4-2.5 s): usage, exit 2" test $? -eq 2
 
 "$gaitsim" predict --guess "$guess" --speed 0.8 --out x --weight accel=-1 >/dev/null 2>&1
 check "predict --weight accel=-1: usage, exit 2" test $? -eq 2

@@ -3,7 +3,8 @@
 # speeds 0.9 (below: the downward chain, in the forked process) and 1.6 (upward chain), 5 nodes,
 # 2 Ipopt iterations each; exit 3 (solves stopped short), one folder per speed with its target
 # speed and log, a table with one row per speed in ascending order and the peak knee contact of
-# both knees; a malformed list exits 2.
+# both knees, and the walk columns (summed vertical GRF minimum, flight and double-support
+# nodes) as each summary.json has them; a malformed list exits 2.
 # usage: sweep.sh GAITSIM SOURCE_DIR
 set -u
 gaitsim=$1 src=$2
@@ -46,6 +47,20 @@ ok = all(abs(float(r["stride_time_change_pct"]) - 100 * (float(r["stride_time_s"
          for r in rows)
 sys.exit(0 if ok and rows else 1)
 PY
+check "csv: walk columns agree with each speed's summary.json (predict's default floor 0.2 BW)" \
+  /usr/bin/python3 - sw <<'PY'
+import csv, json, sys
+rows = list(csv.DictReader(open(sys.argv[1] + "/sweep.csv")))
+ok = bool(rows)
+for r in rows:
+    s = json.load(open("%s/predict_%s/summary.json" % (sys.argv[1], r["speed_mps"])))
+    ok &= (abs(float(r["min_summed_vgrf_bw"]) - s["min_summed_vgrf_bw"]) < 1e-3
+           and int(r["flight_nodes"]) == s["flight_nodes"]
+           and int(r["double_support_nodes"]) == s["double_support_nodes"]
+           and s["min_vgrf_bound_bw"] == 0.2)
+sys.exit(0 if ok else 1)
+PY
+check "markdown: walk column" grep -q "lowest summed vertical GRF (BW); nodes in flight, in double support" sw/sweep.md
 "$gaitsim" sweep --guess guess --speeds 0.8:x:2 --out sw2 >/dev/null 2>&1
 check "malformed speeds: exit 2" test $? -eq 2
 finish

@@ -106,6 +106,8 @@ typedef struct {
   double min_vgrf;     // predict: floor on the summed vertical ground reaction of both feet at
                        // every node (BW; go_gait_opts.min_vgrf), 0: none
   double stride_time;  // predict: > 0: the stride time held at this value (s), 0: free
+  double stride_time_start;  // predict: > 0: a free stride time's starting value (s), 0: the
+                             // guess's
 } gsTrackOptions;
 
 // --weight NAME=VALUE
@@ -1010,6 +1012,8 @@ static const char* kPredictUsage =
     "                      flight_nodes, double_support_nodes tell a walk from a run)\n"
     "  --stride-time S     hold the stride time at S seconds (0.4-2.5) instead of leaving it\n"
     "                      free: the cost of transport at a prescribed cadence\n"
+    "  --stride-time-start S  start the free stride time at S seconds (0.4-2.5; default the\n"
+    "                      guess's): where the solve starts, not a bound\n"
     "  --metabolic-smoothing F  factor on every width of the smooth Umberger 2010 rates\n"
     "                      (steps in u - a, lM~ - 1 and v~, the maxima and minima; widths of\n"
     "                      gs_metabolics.h times F; default 10: steps 0.1 wide, which lets the\n"
@@ -1033,7 +1037,8 @@ int gs_cmd_predict(int argc, char** argv) {
       {"metabolic-smoothing", required_argument, NULL, 'S'},
       {"fallback-rise", required_argument, NULL, 'R'},
       {"min-vgrf", required_argument, NULL, 'W'},
-      {"stride-time", required_argument, NULL, 'D'},          {NULL, 0, NULL, 0}};
+      {"stride-time", required_argument, NULL, 'D'},
+      {"stride-time-start", required_argument, NULL, 'E'},    {NULL, 0, NULL, 0}};
   gsTrackOptions o;
   defaults(&o);
   o.predict = 1;
@@ -1047,7 +1052,7 @@ int gs_cmd_predict(int argc, char** argv) {
   optind = 1;
   int c, bad = 0, model_given = 0;
   char err[256], *end;
-  while ((c = getopt_long(argc, argv, "g:s:o:m:n:t:i:T:w:PFS:R:W:D:p:h", options, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, "g:s:o:m:n:t:i:T:w:PFS:R:W:D:E:p:h", options, NULL)) != -1) {
     switch (c) {
       case 'g': o.guess = optarg; break;
       case 's':
@@ -1072,6 +1077,11 @@ int gs_cmd_predict(int argc, char** argv) {
       case 'D':
         o.stride_time = strtod(optarg, &end);
         bad |= *end || end == optarg || !(o.stride_time >= 0.4 && o.stride_time <= 2.5);
+        break;
+      case 'E':
+        o.stride_time_start = strtod(optarg, &end);
+        bad |= *end || end == optarg ||
+               !(o.stride_time_start >= 0.4 && o.stride_time_start <= 2.5);
         break;
       case 'W':
         o.min_vgrf = strtod(optarg, &end);
@@ -1184,7 +1194,9 @@ static int solve(gsTrackOptions o) {
   gv = (double*)malloc(sizeof(double) * (size_t)mm);
   if (o.predict) {
     memcpy(z, band, sizeof(double) * (size_t)n);
-    retime_progression(g, z, o.speed, o.stride_time > 0 ? o.stride_time : T0);
+    retime_progression(g, z, o.speed,
+                       o.stride_time > 0 ? o.stride_time
+                       : o.stride_time_start > 0 ? o.stride_time_start : T0);
   } else if (o.init) {
     int from_vars = guess_from_variables(g, o.init, z);
     if (from_vars < 0 || (from_vars == 0 && guess_from_folder(g, m, o.init, o.activation, z) != 0))

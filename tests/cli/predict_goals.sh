@@ -99,6 +99,11 @@ sys.exit(0 if ok else 1)
 PY
 check "free stride time: stride_time_fixed_s null" /usr/bin/python3 -c "import json,sys; \
 sys.exit(0 if json.load(open('on/summary.json'))['stride_time_fixed_s'] is None else 1)"
+"$gaitsim" predict --guess "$guess" --speed 0.8 --out start --nodes 5 --max-iter 0 --no-polish \
+  --threads 1 --stride-time-start 1.4 >/dev/null 2>&1
+check "--stride-time-start: the solve starts at 1.4 s, T free" /usr/bin/python3 -c "import json,sys
+s = json.load(open('start/summary.json'))
+sys.exit(0 if abs(s['stride_time_s'] - 1.4) < 1e-12 and s['stride_time_fixed_s'] is None else 1)"
 "$gaitsim" predict --guess "$guess" --speed 0.8 --out x --min-vgrf -1 >/dev/null 2>&1
 check "predict --min-vgrf -1: usage, exit 2" test $? -eq 2
 "$gaitsim" predict --guess "$guess" --speed 0.8 --out x --stride-time 3 >/dev/null 2>&1

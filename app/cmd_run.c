@@ -24,6 +24,8 @@ static const char* kRunUsage =
     "  2. DIR/sweep/predict_V: predictive solves at the speeds of LIST (default 0.8,2.0: 0.8 and\n"
     "     2.0 m/s, each started from the tracking solution as in the paper, in two\n"
     "     processes; a longer LIST is solved by continuation, gaitsim sweep), DIR/sweep/sweep.md;\n"
+    "     walks: the summed vertical ground reaction stays above 0.2 BW (gaitsim predict\n"
+    "     --min-vgrf; not in the paper), so no node is in flight;\n"
     "  3. DIR/*/report/: figures and report.md of every solution, DIR/sweep/report/: the speeds\n"
     "     side by side (kinematics, GRF, excitations, stride and cost against speed, knee);\n"
     "  4. DIR/*/gait.mp4 and strip.png: video (3 strides) and filmstrip of every solution.\n"
@@ -31,9 +33,9 @@ static const char* kRunUsage =
     "stopped short (its best iterate written), else as the failing step.\n\n"
     "  --max-iter N   Ipopt iteration limit of each predictive solve (default 1500: an iteration\n"
     "                 budget, not a time limit, so that the results do not depend on the load\n"
-    "                 of the machine; in the main job of 2026-12-02 they reached Ipopt's\n"
-    "                 acceptable level after 419 (0.8 m/s) and 860 (2.0 m/s) iterations, 7 and\n"
-    "                 12.5 minutes, on 2 cores)\n"
+    "                 of the machine; in the main jobs of 2026-12-02 they reached Ipopt's\n"
+    "                 acceptable level after 419-680 (0.8 m/s) and 505-860 (2.0 m/s)\n"
+    "                 iterations, 6-12.5 minutes, on 2 cores)\n"
     "  --max-time S   wall-clock limit of each predictive solve, s (default none); the tracking\n"
     "                 solve stops after 600 iterations (1000 on a continued mesh)\n";
 

@@ -666,7 +666,7 @@ void go_gait_free(go_gait* g) {
 //   tendon e      hill row e (and muscle i's fibre row) over q and qdot of the dofs muscle i
 //                 crosses, a_i, fT_e, fT'_e
 //   activation i  act row i over a_i, e_i
-// (link rows are linear; the grf variables, q' and adot enter linearly).
+// (link rows and the walk row are linear; the grf variables, q' and adot enter linearly).
 static int build_elements(go_gait* g) {
   const go_gait_layout* L = &g->L;
   int nv = L->nv, na = L->na, ne = L->ne, E = 1 + ne + na;

@@ -327,6 +327,8 @@ def load(args):
         d["knee_left"] = (d["knee"].col("contact_total_l") / d["bw"]
                           if d["knee"].has("contact_total_l") else None)
         d["left_strike_pct"] = heel_strike_pct(d["meas_grf"], "ground_force_l_vy")
+    mpath = os.path.join(sol, "metabolics.sto")
+    d["metab"] = metabolic_breakdown(Storage(mpath)) if os.path.exists(mpath) else None
     d["emg"] = []
     d["emg_skipped"] = []
     for ch, muscles, pct, mean, std in read_emg(EMG_PATH):
@@ -469,6 +471,26 @@ def fmt_value(v):
     return f"{v:.4g}" if abs(v) < 1000 else f"{v:.1f}"
 
 
+METAB_TOP = 10  # muscles listed in report.md's metabolic table
+
+
+def metabolic_breakdown(st):
+    """Mean metabolic power over the stride per muscle (W; trapezoid over time / stride time) from
+    metabolics.sto (gaitsim's per-muscle Umberger 2010 rates, exact, and their "total"): the
+    total and the METAB_TOP largest, each with its share of the total."""
+    import numpy as np
+    t = st.col("time")
+    span = t[-1] - t[0]
+    muscles = [lab for lab in st.labels[1:] if lab != "total"]
+    if not muscles:
+        raise PrepError(st.path, "no muscle column")
+    mean = {m: float(np.trapz(st.col(m), t) / span) for m in muscles}
+    total = float(np.trapz(st.col("total"), t) / span) if st.has("total") else sum(mean.values())
+    top = sorted(muscles, key=lambda m: -mean[m])[:METAB_TOP]
+    return {"total": total, "top": [(m, mean[m], 100.0 * mean[m] / total if total > 0 else
+                                      float("nan")) for m in top]}
+
+
 def report_md(d, figures):
     s = d["summary"]
     rms = s.get("rms") if isinstance(s.get("rms"), dict) else {}
@@ -498,6 +520,15 @@ def report_md(d, figures):
         else:
             text = fmt_value(v)
         lines.append(f"| {name} | {text} |")
+    if d.get("metab") is not None:
+        mb = d["metab"]
+        lines += ["", "## Metabolic power by muscle (Umberger 2010)", "",
+                  f"Mean over the stride: {mb['total']:.1f} W in all, "
+                  f"{mb['total'] / d['mass']:.2f} W/kg (metabolics.sto, the exact rates). "
+                  f"The {len(mb['top'])} largest:", "",
+                  "| muscle | mean power (W) | share of the total (%) |", "|---|---|---|"]
+        for m, w, share in mb["top"]:
+            lines.append(f"| {m} | {w:.1f} | {share:.1f} |")
     lines += ["", "## Figures", ""]
     captions = {
         "kinematics.png": "Kinematics, model vs measured (pelvis, lumbar, hips, knees, ankles), "

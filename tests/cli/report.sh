@@ -2,7 +2,8 @@
 # gaitsim report on a copy of the fixture solution (tests/fixtures/solution_small) with a
 # summary.json carrying RMS errors and solve facts: exit 0; kinematics, grf, knee_contact and
 # excitations PNGs with a valid signature and a plausible size; report.md has the Table 1 rows
-# with these numbers beside the paper's and links the figures; --out writes elsewhere; a folder
+# with these numbers beside the paper's and links the figures, and the metabolic table of a
+# metabolics.sto written here (largest muscle first, mean W and share of the total); --out writes elsewhere; a folder
 # without states.sto, or with a NaN in a used column, exits 1 with one line naming the file and
 # writes no report.md; usage errors exit 2.
 # usage: report.sh GAITSIM SOURCE_DIR
@@ -27,6 +28,13 @@ cat >sol/summary.json <<EOF
 }
 EOF
 
+# metabolics.sto: three muscles at constant 10, 30 and 60 W (their total 100 W) over the stride
+/usr/bin/python3 - sol/metabolics.sto <<'PY'
+import sys
+rows = "".join(f"{0.1 * k:.1f}\t10\t30\t60\t100\n" for k in range(12))
+open(sys.argv[1], "w").write("metabolics\nversion=1\nnRows=12\nnColumns=5\ninDegrees=no\n"
+                             "endheader\ntime\tsoleus\tvaslat\tercspn_r\ttotal\n" + rows)
+PY
 out=$("$gaitsim" report sol)
 check "report exits 0" test $? -eq 0
 check "report names its folder" grep -q "sol/report" <<<"$out"
@@ -35,6 +43,9 @@ for f in kinematics grf knee_contact excitations; do
 done
 md=sol/report/report.md
 check "report.md written" test -s $md
+check "metabolic table: the largest first, mean W and share" \
+  grep -q '^| ercspn_r | 60.0 | 60.0 |$' $md
+check "metabolic table: total" grep -q 'Mean over the stride: 100.0 W in all' $md
 check "row pelvis rotations" grep -q '^| Pelvis rotations | deg | 0.345 | 0.21 |$' $md
 check "row pelvis translations" grep -q '^| Pelvis translations | cm | 0.678 | 0.20 |$' $md
 check "row GRF fore-aft" grep -q '^| GRF fore-aft | BW | 0.0123 | 0.02 |$' $md

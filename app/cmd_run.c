@@ -34,8 +34,8 @@ static const char* kRunUsage =
     "  --max-iter N   Ipopt iteration limit of each predictive solve (default 1500: an iteration\n"
     "                 budget, not a time limit, so that the results do not depend on the load\n"
     "                 of the machine; in the main jobs of 2026-12-02 they reached Ipopt's\n"
-    "                 acceptable level after 419-680 (0.8 m/s) and 505-860 (2.0 m/s)\n"
-    "                 iterations, 6-12.5 minutes, on 2 cores)\n"
+    "                 acceptable level after 419-865 (0.8 m/s) and 481-860 (2.0 m/s)\n"
+    "                 iterations, 6-13 minutes, on 2 cores)\n"
     "  --max-time S   wall-clock limit of each predictive solve, s (default none); the tracking\n"
     "                 solve stops after 600 iterations (1000 on a continued mesh)\n";
 

@@ -230,8 +230,8 @@ int gs_cmd_sweep(int argc, char** argv) {
     const char* keys[7] = {"stride_time_s", "stride_length_m", "cost_of_transport_j_per_kg_m",
                            "body_weight_n", "min_summed_vgrf_bw", "flight_nodes",
                            "double_support_nodes"};
-    double f[7];
-    for (int q = 0; q < 7; q++) {
+    double f[sizeof(keys) / sizeof(keys[0])];
+    for (size_t q = 0; q < sizeof(keys) / sizeof(keys[0]); q++) {
       const cJSON* x = cJSON_GetObjectItemCaseSensitive(j, keys[q]);
       f[q] = cJSON_IsNumber(x) ? x->valuedouble : NAN;
     }

@@ -448,6 +448,12 @@ int go_ipopt_solve(go_nlp* nlp, const go_ipopt_opts* opts, double* z, double* z_
   }
   SetIntermediateCallback(p, cb_iter);
   openblas_set_num_threads(1);
+  // Debian's MUMPS orders the KKT matrix with SCOTCH 7 (orderings 3 and 5: it links no METIS),
+  // whose threaded graph algorithms give a different ordering, and so different pivots and
+  // iterates in the 9th digit, from run to run. One SCOTCH thread makes the ordering, and the
+  // whole solve, bitwise repeatable (docs/BENCHMARKS.md, "Reproducible runs"); SCOTCH reads the
+  // variable at each ordering, and an explicit setting in the environment is left alone.
+  setenv("SCOTCH_PTHREAD_NUMBER", "1", 0);
 
   // Ctrl-C
   struct sigaction old_sa, sa;

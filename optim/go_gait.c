@@ -667,9 +667,18 @@ void go_gait_free(go_gait* g) {
 //                 crosses, a_i, fT_e, fT'_e
 //   activation i  act row i over a_i, e_i
 // (link rows and the walk row are linear; the grf variables, q' and adot enter linearly).
+// Left out of the dynamics element: the coordinates of root slides along a horizontal axis (the
+// pelvis' fore-aft and sideways translations) when there are no ground-moment rows. Every other
+// path row is invariant under a horizontal translation of the whole body: the inverse dynamics
+// and the muscle paths depend on relative positions only, and gaitsim's floor is the plane z = 0
+// (gs_physics.c), so the foot contact depends on heights alone. Those rows are then linear (zero)
+// in these coordinates and have no curvature in them; the moment rows (about the world origin)
+// are not, being r x F.
+static int horizontal_translation(const mjModel* m, int j);
 static int build_elements(go_gait* g) {
   const go_gait_layout* L = &g->L;
   int nv = L->nv, na = L->na, ne = L->ne, E = 1 + ne + na;
+  int moments = L->ngrf > GO_GAIT_GRM_OFFSET;
   int nrows = 2 * nv + 2 * 0 + nv + L->ngrf + ne + 2 * na;  // generous
   int nvars = (3 * nv + na + ne) + ne * (2 * nv + 3) + 2 * na;
   int* mem = (int*)malloc(sizeof(int) * (size_t)(2 * (E + 1) + nrows + nvars));
@@ -682,7 +691,8 @@ static int build_elements(go_gait* g) {
   for (int c = 0; c < L->ngrf; c++) rows[nr++] = L->r_grf + c;
   for (int i = 0; L->r_fib >= 0 && i < na; i++)
     if (L->elastic_of[i] < 0) rows[nr++] = L->r_fib + i;
-  for (int j = 0; j < nv; j++) vars[nvv++] = L->x_q + j;
+  for (int j = 0; j < nv; j++)
+    if (moments || !horizontal_translation(g->m, j)) vars[nvv++] = L->x_q + j;
   for (int j = 0; j < nv; j++) vars[nvv++] = L->x_qd + j;
   for (int i = 0; i < na; i++)
     if (L->elastic_of[i] < 0) vars[nvv++] = L->x_a + i;
@@ -733,6 +743,19 @@ static int build_elements(go_gait* g) {
   }
   g->el = (go_elements){E, row_ptr, rows, var_ptr, vars, g->el_lin, g->el_pairs};
   return 0;
+}
+
+// 1 when dof j is a slide whose ancestors are all slides (so its axis is fixed in the world) and
+// whose axis is horizontal (perpendicular to the world z axis, the floor's normal, to 1e-9)
+static int horizontal_translation(const mjModel* m, int j) {
+  for (int a = j; a >= 0; a = m->dof_parentid[a])
+    if (m->jnt_type[m->dof_jntid[a]] != mjJNT_SLIDE) return 0;
+  mjData* d = mj_makeData(m);
+  if (!d) return 0;
+  mj_kinematics(m, d);  // at qpos0; the axis does not depend on the slides' positions
+  double z = d->xaxis[3 * m->dof_jntid[j] + 2];
+  mj_deleteData(d);
+  return fabs(z) < 1e-9;
 }
 
 const go_elements* go_gait_elements(const go_gait* g) { return &g->el; }

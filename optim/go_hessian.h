@@ -75,8 +75,12 @@ int go_hess_values(go_hess* h, const double* x, double obj_factor, const double*
 //   (A) pairs of finite-difference variables i, j (the columns without path_jac) sharing an element
 //       (and allowed by fd_pairs): second differences of phi_k,
 //       H_ii = (phi(+i) - 2 phi + phi(-i)) / h^2,  H_ij = (phi(+i+j) - phi(+i) - phi(+j) + phi) / h^2,
-//       h = 1e-4 max(1, |z~|) (eps^(1/4), balancing truncation against rounding), one path
-//       evaluation per pair and two per variable;
+//       h = 1e-5 max(1, |z~|), one path evaluation per pair (one-sided: the pair formula reuses
+//       phi(+i) and phi(+j) of the diagonal) and two per variable. The one-sided pair formula
+//       errs by O(h) where the central one (two evaluations per pair) erred by O(h^2); with h
+//       1e-5 instead of 1e-4 the worst entry of tests/test_hessian_fd.c is 9.8e-4 of its
+//       column's largest (central, h 1e-4: 1.1e-4; one-sided at 3e-5: 3.0e-3, at 3e-6 rounding
+//       takes over) for half the evaluations: the pairs are nearly all of them;
 //   (B) a finite-difference variable i with an analytic column w of one element: forward
 //       differences of the analytic partials (path_jac at z + h e_i, h = sqrt(eps) max(1, |z~|));
 //   (C) analytic variables with curvature in some element (not `lin` there): central differences

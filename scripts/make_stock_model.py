@@ -84,8 +84,11 @@ SEGMENTS = {
     "hand_r": [("sphere", 0.045, "0 -0.075 0")],
     "hand_l": [("sphere", 0.045, "0 -0.075 0")],
 }
-FOOT_BODIES = ("calcaneus", "toes", "calcaneus_l", "toes_l")  # carry the fitted spheres only
-SEGMENT_SOLREF = "0.005 1"  # time constant 5 ms (>= 2 timesteps), critical damping
+FOOT_BODIES = ("calcaneus", "toes", "calcaneus_l", "toes_l")  # carry the fitted spheres
+# each foot sphere gets a concentric "stop" sphere (class segment, STOP_DEPTH smaller): beyond the
+# fitted range (hard landings, a collapsing body) it stops the foot sinking further
+STOP_DEPTH = 0.012
+SEGMENT_SOLREF = "0.002 1"  # time constant 2 ms (2 timesteps, the stable minimum), critical damping
 
 
 def fmt(x):
@@ -94,10 +97,13 @@ def fmt(x):
 
 # --- MuJoCo 2.2.2 muscle model (engine_util_misc.c: mju_muscleGain, mju_muscleBias) -----------
 def mj_fl(L, lmin, lmax):
+    """FL of MuJoCo 2.2.2 as coded: below lmin its if-chain falls into the "L <= 1" branch, so FL
+    = 1 - 0.5 ((1 - L) / (1 - a))^2 there, -1 just below lmin and falling (a pushing muscle;
+    later MuJoCo versions return 0). The fit keeps lmin below every reachable length."""
     a, b = 0.5 * (lmin + 1), 0.5 * (1 + lmax)
     out = np.zeros_like(L)
     m1 = (L >= lmin) & (L <= a)
-    m2 = (L > a) & (L <= 1)
+    m2 = ((L > a) | (L < lmin)) & (L <= 1)
     m3 = (L > 1) & (L <= b)
     m4 = (L > b) & (L <= lmax)
     out[m1] = 0.5 * ((L[m1] - lmin) / (a - lmin)) ** 2
@@ -227,11 +233,12 @@ def fit_timeconst(tau_a, tau_d):
     return res.x, math.sqrt(np.mean(res.fun ** 2))
 
 
-def fit_muscle(lmt, force, fmax, lopt, lnorm):
+def fit_muscle(lmt, force, fmax, lopt, lnorm, lmt_min):
     """Fit (s, alpha, beta, lmin, lmax, fpmax) of tension = s Fmax (a FL(L) + FP(L)),
     L = alpha + beta lMT / lopt, to gaitsim's forces (A x P) at activations ACTIVATIONS and
     muscle-tendon lengths lmt (P). lnorm (A x P): gaitsim's lM/lopt, for the first guess.
-    Returns the parameters and the RMS difference / Fmax."""
+    lmt_min (m): the shortest reachable length; a penalty keeps L(lmt_min) >= lmin + 0.02, clear
+    of MuJoCo 2.2.2's negative FL below lmin (mj_fl). Returns the parameters and the RMS difference / Fmax."""
     acts = np.array(ACTIVATIONS)[:, None]
     x = lmt[None, :] / lopt
     target = force / fmax
@@ -251,7 +258,8 @@ def fit_muscle(lmt, force, fmax, lopt, lnorm):
         L = p[1] + p[2] * x
         model = p[0] * (acts * mj_fl(L, p[3], p[4]) + mj_fp(L, p[4], p[5]))
         r = (model - target).ravel()
-        return np.concatenate([r, reg * (p - x0)])
+        below = max(0.0, p[3] + 0.02 - (p[1] + p[2] * lmt_min / lopt))
+        return np.concatenate([r, reg * (p - x0), [10.0 * below]])
 
     best = None
     for shift in (0.0, -0.15, 0.15, -0.3, 0.3):
@@ -341,10 +349,10 @@ def main():
     for i, el in enumerate(muscles):
         u = user_row(el, None, 12)
         fmax, lopt, penn, vmax = u[U_FMAX], u[U_LOPT], u[U_PENN], u[U_VMAX]
-        p, rms = fit_muscle(lmt[:, i], force[:, :, i], fmax, lopt, lnorm[:, :, i])
-        s, alpha, beta, lmin, lmax, fpmax = p
         lr = [float(v) for v in el.get("lengthrange").split()]
         lr = [min(lr[0], lmt[:, i].min()), max(lr[1], lmt[:, i].max())]
+        p, rms = fit_muscle(lmt[:, i], force[:, :, i], fmax, lopt, lnorm[:, :, i], lr[0])
+        s, alpha, beta, lmin, lmax, fpmax = p
         rng = [alpha + beta * lr[0] / lopt, alpha + beta * lr[1] / lopt]
         L0 = lopt / beta
         vmax_mj = vmax * lopt * math.cos(penn) / (vel_c * L0)
@@ -367,6 +375,7 @@ def main():
     contact_def = defaults.find("./default[@class='contact']/geom")
     contact_user = contact_def.get("user")
     K1, solimp, contact_fit_err = fit_contact_shape()
+    stops = []
     parents = {c: p for p in root.iter() for c in p}
     for g in root.iter("geom"):
         if g.get("class") != "contact":
@@ -383,6 +392,7 @@ def main():
         g.set("solref", f"{fmt(-K * dmax * dmax)} {fmt(-B * dmax)}")
         g.set("solimp", " ".join(fmt(v) for v in solimp))
         g.set("friction", f"{fmt(urow[G_MUD])} 0.005 0.0001")
+        stops.append((parents[g], g))
     contact_def.set("friction", "0.8 0.005 0.0001")
     contact_def.set("condim", "3")
     opt = root.find("./option")
@@ -397,6 +407,11 @@ def main():
     ET.SubElement(seg_def, "geom", {"contype": "2", "conaffinity": "0", "group": "1",
                                     "condim": "3", "solref": SEGMENT_SOLREF,
                                     "rgba": "0.85 0.8 0.7 0.4"})
+    for body, g in stops:
+        stop = ET.Element("geom", {"name": "stop" + g.get("name")[len("contact"):],
+                                   "class": "segment", "type": "sphere", "pos": g.get("pos"),
+                                   "size": fmt(float(g.get("size").split()[0]) - STOP_DEPTH)})
+        body.insert(list(body).index(g) + 1, stop)
     bodies = {b.get("name"): b for b in root.iter("body")}
     for name, geoms in SEGMENTS.items():
         body = bodies[name]
@@ -445,7 +460,8 @@ def main():
     penetration (largest relative error of the fit {contact_fit_err:.3f}; contact inverse
     weights from body_invweight0 of mujoco-compile, 2 significant digits); elliptic cone,
     friction {fmt(user_row(contact_def, contact_user, 6)[G_MUD])}. Segment collision geoms (class
-    segment) touch only the floor.
+    segment) touch only the floor; a concentric stop sphere {STOP_DEPTH * 1000:.0f} mm smaller inside
+    each foot sphere ends the fitted range.
   Knee: the source's placeholder springs hold the five secondary right-knee coordinates
     (a 1-DOF knee in effect); gaitsim's implant-knee surrogate is not represented.
 -->

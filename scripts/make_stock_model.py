@@ -259,7 +259,7 @@ def fit_muscle(lmt, force, fmax, lopt, lnorm, lmt_min):
         model = p[0] * (acts * mj_fl(L, p[3], p[4]) + mj_fp(L, p[4], p[5]))
         r = (model - target).ravel()
         below = max(0.0, p[3] + 0.02 - (p[1] + p[2] * lmt_min / lopt))
-        return np.concatenate([r, reg * (p - x0), [10.0 * below]])
+        return np.concatenate([r, reg * (p - x0), [1e3 * below]])
 
     best = None
     for shift in (0.0, -0.15, 0.15, -0.3, 0.3):

@@ -8,10 +8,13 @@
 //      mid-stance (t = 0.36 s): vertical force within 15 % of gaitsim's Hunt-Crossley spheres at
 //      the same penetrations (stock: the force that holds the still contact, efc_aref / efc_R of
 //      each contact's normal row, the fixed point of MuJoCo's soft-contact solver);
-//   3. 2 s from the `standing` keyframe with zero controls: no collision geom more than 2 cm
-//      below the floor, the secondary right-knee coordinates within physiological ranges of
-//      standing (anterior-posterior knee_tx 10 mm, as an anterior drawer; knee_ty and knee_tz
-//      5 mm; adduction 5 deg; rotation 10 deg), no MuJoCo warning, finite state.
+//   3. 2 s from the `standing` keyframe with zero controls (the passive body collapses): no
+//      collision geom more than 2 cm below the floor, the secondary right-knee coordinates within
+//      physiological ranges of standing (anterior-posterior knee_tx 10 mm, as an anterior drawer;
+//      knee_ty and knee_tz 5 mm; adduction 5 deg; rotation 10 deg), no MuJoCo warning, finite
+//      state; and 1 s more: the body rests on the floor (at 3 s the contacts' vertical force is
+//      body weight within 5 % and no speed exceeds 0.5 m/s or rad/s; measured 0.15), still no
+//      geom 2 cm below the floor.
 #include <math.h>
 #include <mujoco/mujoco.h>
 #include <stdio.h>
@@ -42,6 +45,10 @@
 #define KNEE_TRANS_TOL 0.005  // knee_ty, knee_tz from standing (m)
 #define KNEE_ADD_TOL 0.0873   // knee_adduction from standing (rad, 5 deg)
 #define KNEE_ROT_TOL 0.1745   // knee_rotation from standing (rad, 10 deg)
+#define DROP_TIME 2.0         // checked span of the drop (s)
+#define REST_TIME 3.0         // time by which the body rests (s)
+#define REST_FORCE_TOL 0.05   // vertical contact force at rest, relative to body weight (-)
+#define REST_SPEED_TOL 0.5    // largest |qvel| at rest (m/s or rad/s)
 
 static const double ACTS[NACT] = {0.05, 0.5, 1.0};
 
@@ -256,8 +263,19 @@ static void test_standing_drop(const mjModel* s) {
   }
   double deepest = INFINITY;
   int deep_geom = -1, finite = 1;
-  int nstep = (int)(2.0 / s->opt.timestep + 0.5);
-  for (int step = 0; step < nstep; step++) {
+  int nstep = (int)(DROP_TIME / s->opt.timestep + 0.5);
+  int nrest = (int)(REST_TIME / s->opt.timestep + 0.5);
+  for (int step = 0; step < nrest; step++) {
+    if (step == nstep) {
+      printf("2 s from standing, zero controls: deepest geom %.1f mm (%s), pelvis_ty %.3f m\n",
+             1000 * deepest, deep_geom >= 0 ? mj_id2name(s, mjOBJ_GEOM, deep_geom) : "-",
+             d->qpos[s->jnt_qposadr[mj_name2id(s, mjOBJ_JOINT, "pelvis_ty")]]);
+      EXPECT_TRUE(deepest >= -FLOOR_TOL);
+      for (int k = 0; k < 5; k++) {
+        printf("  %s: largest change %.4g\n", names[k], dev[k]);
+        EXPECT_TRUE(dev[k] <= tol[k]);
+      }
+    }
     mju_zero(d->ctrl, s->nu);
     mj_step(s, d);
     int g = -1;
@@ -272,15 +290,22 @@ static void test_standing_drop(const mjModel* s) {
     }
     for (int i = 0; i < s->nq; i++) finite &= isfinite(d->qpos[i]);
   }
-  printf("2 s from standing, zero controls: deepest geom %.1f mm (%s), pelvis_ty %.3f m\n",
-         1000 * deepest, deep_geom >= 0 ? mj_id2name(s, mjOBJ_GEOM, deep_geom) : "-",
-         d->qpos[s->jnt_qposadr[mj_name2id(s, mjOBJ_JOINT, "pelvis_ty")]]);
   EXPECT_TRUE(finite);
-  EXPECT_TRUE(deepest >= -FLOOR_TOL);
-  for (int k = 0; k < 5; k++) {
-    printf("  %s: largest change %.4g\n", names[k], dev[k]);
-    EXPECT_TRUE(dev[k] <= tol[k]);
+
+  // at rest: the contacts carry body weight, nothing moves fast
+  double fz = 0.0, vmax = 0.0, weight = mj_getTotalmass((mjModel*)s) * -s->opt.gravity[2];
+  for (int c = 0; c < d->ncon; c++) {
+    mjtNum f[6];
+    mj_contactForce(s, d, c, f);
+    fz += f[0] * fabs(d->contact[c].frame[2]);
   }
+  for (int i = 0; i < s->nv; i++) vmax = fmax(vmax, fabs(d->qvel[i]));
+  printf("at %.0f s: vertical contact force %.1f N (body weight %.1f N), largest speed %.3f; "
+         "deepest geom over %.0f s %.1f mm\n", REST_TIME, fz, weight, vmax, REST_TIME,
+         1000 * deepest);
+  EXPECT_TRUE(deepest >= -FLOOR_TOL);
+  EXPECT_REL(weight, fz, REST_FORCE_TOL, 1.0);
+  EXPECT_TRUE(vmax <= REST_SPEED_TOL);
   for (int w = 0; w < mjNWARNING; w++) {
     if (d->warning[w].number) fprintf(stderr, "MuJoCo warning %d raised\n", w);
     EXPECT_EQ_INT(0, d->warning[w].number);

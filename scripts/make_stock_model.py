@@ -238,7 +238,8 @@ def fit_muscle(lmt, force, fmax, lopt, lnorm, lmt_min):
     L = alpha + beta lMT / lopt, to gaitsim's forces (A x P) at activations ACTIVATIONS and
     muscle-tendon lengths lmt (P). lnorm (A x P): gaitsim's lM/lopt, for the first guess.
     lmt_min (m): the shortest reachable length; a penalty keeps L(lmt_min) >= lmin + 0.02, clear
-    of MuJoCo 2.2.2's negative FL below lmin (mj_fl). Returns the parameters and the RMS difference / Fmax."""
+    of MuJoCo 2.2.2's negative FL below lmin (mj_fl). Returns the parameters and the RMS
+    difference / Fmax."""
     acts = np.array(ACTIVATIONS)[:, None]
     x = lmt[None, :] / lopt
     target = force / fmax
@@ -263,7 +264,7 @@ def fit_muscle(lmt, force, fmax, lopt, lnorm, lmt_min):
 
     best = None
     for shift in (0.0, -0.15, 0.15, -0.3, 0.3):
-        x0 = np.array([math.cos(0.0), alpha0 + shift, beta0, 0.45, 1.6, 1.3])
+        x0 = np.array([1.0, alpha0 + shift, beta0, 0.45, 1.6, 1.3])
         x0 = np.clip(x0, np.array(lo) + 1e-9, np.array(hi) - 1e-9)
         res = least_squares(lambda p: resid(p, 1e-3), x0, bounds=(lo, hi), x_scale="jac")
         rms = math.sqrt(np.mean(res.fun[:target.size] ** 2))
@@ -463,9 +464,9 @@ def main():
     static force (efc_aref / efc_R) matches gaitsim's Hunt-Crossley force for 2-15 mm
     penetration (largest relative error of the fit {contact_fit_err:.3f}; contact inverse
     weights from body_invweight0 of mujoco-compile, 2 significant digits); elliptic cone,
-    friction {fmt(user_row(contact_def, contact_user, 6)[G_MUD])}. Segment collision geoms (class
-    segment) touch only the floor; a concentric stop sphere {STOP_DEPTH * 1000:.0f} mm smaller inside
-    each foot sphere ends the fitted range.
+    friction {fmt(user_row(contact_def, contact_user, 6)[G_MUD])}. Collision geoms of class
+    segment touch only the floor: one or two per segment, and inside each foot sphere a
+    concentric stop sphere {STOP_DEPTH * 1000:.0f} mm smaller that ends the fitted range.
   Knee: the source's placeholder springs hold the five secondary right-knee coordinates
     (a 1-DOF knee in effect); gaitsim's implant-knee surrogate is not represented.
 -->

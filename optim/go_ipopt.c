@@ -31,7 +31,7 @@ static void on_sigint(int sig) {
 void go_ipopt_opts_default(go_ipopt_opts* o) {
   memset(o, 0, sizeof(*o));
   o->max_iter = -1;
-  o->best_viol_tol = 1e-6;
+  o->best_viol_tol = 1e-3;
 }
 
 int go_ipopt_opts_set(go_ipopt_opts* o, const char* key, const char* val, char* err, int errsz) {

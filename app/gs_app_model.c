@@ -1,9 +1,12 @@
 // gs_app_model.c: model preparation and table I/O shared by the subcommands.
 #include "app/gs_app_model.h"
 
+#include <errno.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <cjson/cJSON.h>
 
@@ -87,4 +90,93 @@ const char* gs_app_solution_model(const char* dir, char* buf, int n) {
   }
   cJSON_Delete(j);
   return found;
+}
+
+int gs_app_check_solution(const char* dir, int require_summary) {
+  char path[4096], err[1024];
+  struct stat st;
+  if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) {
+    fprintf(stderr, "gaitsim: %s: %s\n", dir,
+            stat(dir, &st) != 0 ? strerror(errno) : "not a folder");
+    return -1;
+  }
+  // summary.json: valid when present; its node count
+  snprintf(path, sizeof(path), "%s/summary.json", dir);
+  int nodes = -1;
+  if (access(path, F_OK) == 0) {
+    cJSON* j = gs_app_read_json(path);
+    if (!j) {
+      fprintf(stderr, "gaitsim: %s: unreadable or not valid JSON (an incomplete solution "
+              "folder?)\n", path);
+      return -1;
+    }
+    const cJSON* n = cJSON_GetObjectItemCaseSensitive(j, "nodes");
+    if (cJSON_IsNumber(n)) nodes = (int)n->valuedouble;
+    cJSON_Delete(j);
+  } else if (require_summary) {
+    fprintf(stderr, "gaitsim: %s: no summary.json: not a complete solution folder\n", dir);
+    return -1;
+  }
+  // every storage file reads; the node tables agree
+  static const char* files[] = {"states.sto", "controls.sto", "variables.sto", "grf.mot",
+                                "muscle_forces.sto", "metabolics.sto", "knee_contact.sto"};
+  int rows = nodes, rows_from = -1;  // rows_from: files[] index that set rows, -1 summary
+  for (int i = 0; i < (int)(sizeof(files) / sizeof(files[0])); i++) {
+    snprintf(path, sizeof(path), "%s/%s", dir, files[i]);
+    if (access(path, F_OK) != 0) {
+      if (i > 0) continue;
+      fprintf(stderr, "gaitsim: %s: missing: not a complete solution folder\n", path);
+      return -1;
+    }
+    gsTable t;
+    gs_table_init(&t);
+    if (gs_storage_read(path, &t, err, sizeof(err)) != 0) {
+      fprintf(stderr, "gaitsim: %s\n", err);
+      return -1;
+    }
+    int n = t.nrow;
+    gs_table_free(&t);
+    if (i > 2) continue;
+    if (rows >= 0 && n != rows) {
+      fprintf(stderr, "gaitsim: %s: %d rows, but %s %d: files of different solutions\n", path,
+              n, rows_from < 0 ? "summary.json says nodes =" : files[rows_from], rows);
+      return -1;
+    }
+    if (rows < 0) rows = n, rows_from = i;
+  }
+  return 0;
+}
+
+int gs_app_require_coordinates(const mjModel* m, const gsTable* t, const char* path) {
+  char list[512] = "";
+  int missing = 0, total = 0;
+  size_t len = 0;
+  for (int j = 0; j < m->njnt; j++) {
+    if (m->jnt_type[j] != mjJNT_HINGE && m->jnt_type[j] != mjJNT_SLIDE) continue;
+    total++;
+    const char* name = mj_id2name(m, mjOBJ_JOINT, j);
+    if (name && gs_table_column(t, name) >= 0) continue;
+    if (missing < 6 && len < sizeof(list)) {
+      len += (size_t)snprintf(list + len, sizeof(list) - len, "%s%s", missing ? ", " : "",
+                              name ? name : "(unnamed)");
+    } else if (missing == 6 && len < sizeof(list)) {
+      len += (size_t)snprintf(list + len, sizeof(list) - len, ", ...");
+    }
+    missing++;
+  }
+  if (missing == 0) return 0;
+  fprintf(stderr, "gaitsim: %s: no column for %d of the model's %d coordinates: %s\n", path,
+          missing, total, list);
+  return -1;
+}
+
+int gs_app_check_pose_file(const mjModel* m, const char* path) {
+  char err[1024];
+  gsTable t;
+  gs_table_init(&t);
+  int rc = gs_storage_read(path, &t, err, sizeof(err));
+  if (rc != 0) fprintf(stderr, "gaitsim: %s\n", err);
+  else rc = gs_app_require_coordinates(m, &t, path);
+  gs_table_free(&t);
+  return rc;
 }

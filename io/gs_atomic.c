@@ -39,15 +39,52 @@ static char* dir_of(const char* path) {
 static void release(gsAtomicFile* a) {
   free(a->path);
   free(a->tmppath);
+  free(a->sink);
   a->f = NULL;
   a->path = NULL;
   a->tmppath = NULL;
+  a->sink = NULL;
+}
+
+// the stream's sink: its file descriptor and the errno of the first write that failed
+typedef struct {
+  int fd;   // the temporary file
+  int err;  // errno of the first failed write, 0 none
+} atomicSink;
+
+static ssize_t sink_write(void* cookie, const char* buf, size_t n) {
+  atomicSink* s = (atomicSink*)cookie;
+  size_t done = 0;
+  while (done < n) {
+    ssize_t w = write(s->fd, buf + done, n - done);
+    if (w < 0 && errno == EINTR) continue;
+    if (w <= 0) {
+      if (!s->err) s->err = w < 0 ? errno : ENOSPC;
+      return done > 0 ? (ssize_t)done : -1;
+    }
+    done += (size_t)w;
+  }
+  return (ssize_t)done;
+}
+
+static int sink_close(void* cookie) {
+  atomicSink* s = (atomicSink*)cookie;
+  int rc = s->fd >= 0 ? close(s->fd) : 0;
+  s->fd = -1;
+  return rc;
+}
+
+// the errno of a's first failed write, else fallback
+static int sink_errno(const gsAtomicFile* a, int fallback) {
+  const atomicSink* s = (const atomicSink*)a->sink;
+  return s && s->err ? s->err : fallback;
 }
 
 int gs_atomic_open(gsAtomicFile* a, const char* path, char* err, int errsz) {
   a->f = NULL;
   a->path = NULL;
   a->tmppath = NULL;
+  a->sink = NULL;
   if (!path || !path[0]) {
     gs_error_set(err, errsz, "gs_atomic_open: empty path");
     return -1;
@@ -86,7 +123,14 @@ int gs_atomic_open(gsAtomicFile* a, const char* path, char* err, int errsz) {
     return -1;
   }
 
-  a->f = fdopen(fd, "wb");
+  atomicSink* sink = (atomicSink*)malloc(sizeof(atomicSink));
+  cookie_io_functions_t io = {NULL, sink_write, NULL, sink_close};
+  if (sink) {
+    sink->fd = fd;
+    sink->err = 0;
+    a->sink = sink;
+    a->f = fopencookie(sink, "wb", io);
+  }
   if (!a->f) {
     gs_error_set(err, errsz, "%s: cannot open temporary file: %s", path, strerror(errno));
     close(fd);
@@ -124,7 +168,7 @@ int gs_atomic_commit(gsAtomicFile* a, char* err, int errsz) {
     failed = 1;
     saved = errno;
   }
-  if (!failed && fsync(fileno(a->f)) != 0) {
+  if (!failed && fsync(((atomicSink*)a->sink)->fd) != 0) {
     failed = 1;
     saved = errno;
   }
@@ -135,6 +179,7 @@ int gs_atomic_commit(gsAtomicFile* a, char* err, int errsz) {
     saved = errno;
   }
   if (failed) {
+    saved = sink_errno(a, saved);
     gs_error_set(err, errsz, "%s: write failed: %s", a->path, strerror(saved));
     gs_atomic_abort(a);
     return -1;
@@ -167,7 +212,7 @@ int gs_atomic_write_buffer(const char* path, const void* bytes, size_t n, char* 
     return -1;
   }
   if (n > 0 && fwrite(bytes, 1, n, a.f) != n) {
-    gs_error_set(err, errsz, "%s: write failed: %s", path, strerror(errno));
+    gs_error_set(err, errsz, "%s: write failed: %s", path, strerror(sink_errno(&a, errno)));
     gs_atomic_abort(&a);
     return -1;
   }

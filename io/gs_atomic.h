@@ -22,6 +22,8 @@ typedef struct gsAtomicFile_ {
   FILE* f;        // stream to write to (the temporary file); NULL when not open
   char* path;     // final path (owned)
   char* tmppath;  // temporary path in the same directory, path.tmp.XXXXXX (owned)
+  void* sink;     // the stream's file descriptor and the errno of its first failed write, so
+                  // that a full disk is reported as ENOSPC, not as a bare stream error (owned)
 } gsAtomicFile;
 
 // Create the temporary file for `path`. The new file gets the mode of an existing target, else

@@ -17,6 +17,7 @@
 #include "app/gs_commands.h"
 #include "app/gs_options.h"
 #include "callbacks/gs_knee.h"
+#include "callbacks/gs_model_info.h"
 #include "callbacks/gs_knee_reaction.h"
 #include "callbacks/gs_physics.h"
 #include "callbacks/gs_state.h"
@@ -1123,6 +1124,15 @@ static int solve(gsTrackOptions o) {
   if (from && gs_app_check_solution(from, 1) != 0) return GS_EXIT_FAILURE;
   mjModel* m = gs_app_load_model(o.model);
   if (!m) return GS_EXIT_FAILURE;
+  gsModelInfo info;  // a gait needs both feet on the ground
+  gs_model_info(m, &info);
+  if (info.ncontact_r == 0 || info.ncontact_l == 0) {
+    fprintf(stderr, "gaitsim: %s: no foot contact spheres (contact_r_*: %d, contact_l_*: %d); "
+            "a gait needs both feet (gaitsim info MODEL)\n", o.model, info.ncontact_r,
+            info.ncontact_l);
+    mj_deleteModel(m);
+    return GS_EXIT_FAILURE;
+  }
   gsFolderTx tx = {NULL, NULL, NULL};
   int status = GS_EXIT_FAILURE;
   gsTable coords, grf;

@@ -15,8 +15,51 @@
 #include "callbacks/gs_state.h"
 #include "io/gs_storage.h"
 
+// An MJCF file must say <compiler angle="radian">: gaitsim's numbers (joint ranges, keyframes,
+// storage files converted from degrees) are radians, and MuJoCo's default is degrees, which
+// would silently turn a range of 1.5 into 1.5 degrees. 0, or -1 with err. Binary models (.mjb)
+// are compiled already.
+static int check_radians(const char* path, char* err, int errsz) {
+  size_t n = strlen(path);
+  if (n < 4 || strcmp(path + n - 4, ".xml") != 0) return 0;
+  FILE* f = fopen(path, "rb");
+  if (!f) return 0;  // gs_model_load reports it
+  char* text = NULL;
+  size_t len = 0, got;
+  char buf[8192];
+  while ((got = fread(buf, 1, sizeof(buf), f)) > 0) {
+    char* t = (char*)realloc(text, len + got + 1);
+    if (!t) break;
+    text = t;
+    memcpy(text + len, buf, got);
+    len += got;
+  }
+  fclose(f);
+  if (!text) return 0;
+  text[len] = 0;
+  int radian = 0, degree = 0;
+  for (const char* c = strstr(text, "<compiler"); c; c = strstr(c + 1, "<compiler")) {
+    const char* end = strchr(c, '>');
+    const char* a = strstr(c, "angle=");
+    if (!end || !a || a > end) continue;
+    a += 6;
+    char q = *a == '"' || *a == '\'' ? *a++ : 0;
+    radian |= strncmp(a, "radian", 6) == 0 && (!q || a[6] == q);
+    degree |= strncmp(a, "degree", 6) == 0 && (!q || a[6] == q);
+  }
+  free(text);
+  if (radian && !degree) return 0;
+  snprintf(err, (size_t)errsz, "angles must be in radians: <compiler angle=\"radian\"> %s",
+           degree ? "(the model says degree)" : "is missing (MuJoCo's default is degree)");
+  return -1;
+}
+
 mjModel* gs_app_load_model(const char* path) {
   char err[1024];
+  if (check_radians(path, err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s: %s\n", path, err);
+    return NULL;
+  }
   mjModel* m = gs_model_load(path, err, sizeof(err));
   if (!m) {
     fprintf(stderr, "gaitsim: %s: %s\n", path, err);

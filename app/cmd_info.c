@@ -119,9 +119,7 @@ int gs_cmd_info(int argc, char** argv) {
       default: return gs_opt_getopt_error("info", c, argv);
     }
   }
-  if (optind == argc) return gs_opt_usage_error("info", "missing MODEL");
-  if (optind < argc - 1)
-    return gs_opt_usage_error("info", "unexpected argument '%s'", argv[optind + 1]);
+  if (gs_opt_one_operand("info", "MODEL", argc, argv) != 0) return GS_EXIT_USAGE;
   const char* path = argv[optind];
   char err[1024];
   mjModel* m = gs_model_load(path, err, sizeof(err));

@@ -47,9 +47,7 @@ int gs_cmd_inspect(int argc, char** argv) {
     }
   }
   if (bad) return GS_EXIT_USAGE;
-  if (optind == argc) return gs_opt_usage_error("inspect", "missing MODEL");
-  if (optind < argc - 1)
-    return gs_opt_usage_error("inspect", "unexpected argument '%s'", argv[optind + 1]);
+  if (gs_opt_one_operand("inspect", "MODEL", argc, argv) != 0) return GS_EXIT_USAGE;
   if (!pose) return gs_opt_usage_error("inspect", "missing --pose FILE");
   const char* path = argv[optind];
   mjModel* m = gs_app_load_model(path);

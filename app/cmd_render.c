@@ -131,9 +131,8 @@ int gs_cmd_render(int argc, char** argv) {
     }
   }
   if (bad) return GS_EXIT_USAGE;
-  if (optind == argc) return gs_opt_usage_error("render", "missing SOLUTION_DIR or MODEL.xml");
-  if (optind < argc - 1)
-    return gs_opt_usage_error("render", "unexpected argument '%s'", argv[optind + 1]);
+  if (gs_opt_one_operand("render", "SOLUTION_DIR or MODEL.xml", argc, argv) != 0)
+    return GS_EXIT_USAGE;
   int nmodes = (out || frames) + (png != NULL) + (strip != NULL);
   if (nmodes != 1)
     return gs_opt_usage_error("render", "give exactly one of --out/--frames, --png, --strip");

@@ -59,9 +59,7 @@ int gs_cmd_report(int argc, char** argv) {
       default: return gs_opt_getopt_error("report", c, argv);
     }
   }
-  if (optind == argc) return gs_opt_usage_error("report", "missing DIR");
-  if (optind < argc - 1)
-    return gs_opt_usage_error("report", "unexpected argument '%s'", argv[optind + 1]);
+  if (gs_opt_one_operand("report", "DIR", argc, argv) != 0) return GS_EXIT_USAGE;
   // a solution folder (not a sweep's) is checked whole before the figures are drawn: every
   // storage file reads, the node tables agree
   char csv[4200];

@@ -90,26 +90,17 @@ int gs_cmd_run(int argc, char** argv) {
   optind = 1;
   opterr = 0;
   int c, bad = 0, k;
-  double x, v[GS_MAX_SPEEDS];
+  double v[GS_MAX_SPEEDS];
   // every value the steps are given is checked here, before the first solve
   while (!bad && (c = getopt_long(argc, argv, ":o:n:t:T:i:s:Vh", options, NULL)) != -1) {
     switch (c) {
       case 'o': out = optarg; break;
-      case 'n':
-        nodes = optarg;
-        bad = gs_opt_int("--nodes", optarg, GS_MIN_NODES, GS_MAX_NODES, &k);
-        break;
+      case 'n': bad = gs_opt_solve_limit(c, optarg, &nodes); break;
+      case 'T': bad = gs_opt_solve_limit(c, optarg, &max_time); break;
+      case 'i': bad = gs_opt_solve_limit(c, optarg, &max_iter); break;
       case 't':
         threads = optarg;
         bad = gs_opt_int("--threads", optarg, 1, 64, &k);
-        break;
-      case 'T':
-        max_time = optarg;
-        bad = gs_opt_real("--max-time", optarg, 0, HUGE_VAL, GS_OPT_LO_OPEN, &x);
-        break;
-      case 'i':
-        max_iter = optarg;
-        bad = gs_opt_int("--max-iter", optarg, 0, GS_OPT_NO_MAX, &k);
         break;
       case 's':
         bad = gs_opt_speeds("--speeds", optarg, v) < 0;

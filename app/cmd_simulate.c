@@ -79,9 +79,7 @@ static int parse(int argc, char** argv, gsSimulateOptions* o) {
     }
   }
   if (bad) return GS_EXIT_USAGE;
-  if (optind == argc) return gs_opt_usage_error("simulate", "missing MODEL");
-  if (optind < argc - 1)
-    return gs_opt_usage_error("simulate", "unexpected argument '%s'", argv[optind + 1]);
+  if (gs_opt_one_operand("simulate", "MODEL", argc, argv) != 0) return GS_EXIT_USAGE;
   if (!o->out) return gs_opt_usage_error("simulate", "missing --out DIR");
   if (o->duration * o->rate > GS_SIMULATE_MAX_ROWS) {
     fprintf(stderr, "gaitsim: --duration, --rate: at most %.0g output rows (got %g s x %g Hz)\n",

@@ -242,9 +242,7 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
     }
   }
   if (bad) return GS_EXIT_USAGE;
-  if (optind == argc) return gs_opt_usage_error("track", "missing TRIAL_DIR");
-  if (optind < argc - 1)
-    return gs_opt_usage_error("track", "unexpected argument '%s'", argv[optind + 1]);
+  if (gs_opt_one_operand("track", "TRIAL_DIR", argc, argv) != 0) return GS_EXIT_USAGE;
   if (!o->out) return gs_opt_usage_error("track", "missing --out DIR");
   if (o->guess_static && o->init)
     return gs_opt_usage_error("track", "--guess-method static and --init exclude each other");

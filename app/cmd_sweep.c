@@ -124,8 +124,8 @@ int gs_cmd_sweep(int argc, char** argv) {
       {"help", no_argument, NULL, 'h'},
       {NULL, 0, NULL, 0}};
   const char *guess = NULL, *dir = NULL, *nodes = "20", *max_time = NULL, *max_iter = "1500";
-  double v[SWEEP_MAX_SPEEDS], limit;
-  int n = -1, c, bad = 0, k;
+  double v[SWEEP_MAX_SPEEDS];
+  int n = -1, c, bad = 0;
   optind = 1;
   opterr = 0;
   // every value checked here; predict gets the words as given
@@ -134,18 +134,9 @@ int gs_cmd_sweep(int argc, char** argv) {
       case 'g': guess = optarg; break;
       case 's': bad = (n = gs_opt_speeds("--speeds", optarg, v)) < 0; break;
       case 'o': dir = optarg; break;
-      case 'n':
-        nodes = optarg;
-        bad = gs_opt_int("--nodes", optarg, GS_MIN_NODES, GS_MAX_NODES, &k);
-        break;
-      case 'T':
-        max_time = optarg;
-        bad = gs_opt_real("--max-time", optarg, 0, HUGE_VAL, GS_OPT_LO_OPEN, &limit);
-        break;
-      case 'i':
-        max_iter = optarg;
-        bad = gs_opt_int("--max-iter", optarg, 0, GS_OPT_NO_MAX, &k);
-        break;
+      case 'n': bad = gs_opt_solve_limit(c, optarg, &nodes); break;
+      case 'T': bad = gs_opt_solve_limit(c, optarg, &max_time); break;
+      case 'i': bad = gs_opt_solve_limit(c, optarg, &max_iter); break;
       case 'h': fputs(kSweepUsage, stdout); return GS_EXIT_OK;
       default: return gs_opt_getopt_error("sweep", c, argv);
     }

@@ -2,6 +2,7 @@
 #include "app/gs_app_model.h"
 
 #include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -15,6 +16,29 @@
 #include "callbacks/gs_state.h"
 #include "io/gs_storage.h"
 
+// the whole file at path, NUL-terminated (caller frees), or NULL when it cannot be read
+static char* read_text(const char* path) {
+  FILE* f = fopen(path, "rb");
+  if (!f) return NULL;
+  char* text = NULL;
+  size_t len = 0, got;
+  char buf[8192];
+  while ((got = fread(buf, 1, sizeof(buf), f)) > 0) {
+    char* t = (char*)realloc(text, len + got + 1);
+    if (!t) {
+      free(text);
+      fclose(f);
+      return NULL;
+    }
+    text = t;
+    memcpy(text + len, buf, got);
+    len += got;
+  }
+  fclose(f);
+  if (text) text[len] = 0;
+  return text;
+}
+
 // An MJCF file must say <compiler angle="radian">: gaitsim's numbers (joint ranges, keyframes,
 // storage files converted from degrees) are radians, and MuJoCo's default is degrees, which
 // would silently turn a range of 1.5 into 1.5 degrees. 0, or -1 with err. Binary models (.mjb)
@@ -22,21 +46,8 @@
 static int check_radians(const char* path, char* err, int errsz) {
   size_t n = strlen(path);
   if (n < 4 || strcmp(path + n - 4, ".xml") != 0) return 0;
-  FILE* f = fopen(path, "rb");
-  if (!f) return 0;  // gs_model_load reports it
-  char* text = NULL;
-  size_t len = 0, got;
-  char buf[8192];
-  while ((got = fread(buf, 1, sizeof(buf), f)) > 0) {
-    char* t = (char*)realloc(text, len + got + 1);
-    if (!t) break;
-    text = t;
-    memcpy(text + len, buf, got);
-    len += got;
-  }
-  fclose(f);
-  if (!text) return 0;
-  text[len] = 0;
+  char* text = read_text(path);
+  if (!text) return 0;  // gs_model_load reports it
   int radian = 0, degree = 0;
   for (const char* c = strstr(text, "<compiler"); c; c = strstr(c + 1, "<compiler")) {
     const char* end = strchr(c, '>');
@@ -97,21 +108,8 @@ int gs_app_write_table(const char* dir, const char* name, const gsTable* t) {
 }
 
 cJSON* gs_app_read_json(const char* path) {
-  FILE* f = fopen(path, "rb");
-  if (!f) return NULL;
-  char* text = NULL;
-  size_t len = 0, got;
-  char buf[4096];
-  while ((got = fread(buf, 1, sizeof(buf), f)) > 0) {
-    char* t = (char*)realloc(text, len + got + 1);
-    if (!t) break;
-    text = t;
-    memcpy(text + len, buf, got);
-    len += got;
-  }
-  fclose(f);
+  char* text = read_text(path);
   if (!text) return NULL;
-  text[len] = 0;
   cJSON* j = cJSON_Parse(text);
   free(text);
   return j;
@@ -154,7 +152,13 @@ int gs_app_check_solution(const char* dir, int require_summary) {
       return -1;
     }
     const cJSON* n = cJSON_GetObjectItemCaseSensitive(j, "nodes");
-    if (cJSON_IsNumber(n)) nodes = (int)n->valuedouble;
+    double v = cJSON_IsNumber(n) ? n->valuedouble : 1;
+    if (n && !(cJSON_IsNumber(n) && v >= 1 && v <= 1e6 && v == floor(v))) {
+      fprintf(stderr, "gaitsim: %s: \"nodes\" is not a node count\n", path);
+      cJSON_Delete(j);
+      return -1;
+    }
+    if (n) nodes = (int)v;
     cJSON_Delete(j);
   } else if (require_summary) {
     fprintf(stderr, "gaitsim: %s: no summary.json: not a complete solution folder\n", dir);

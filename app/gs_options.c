@@ -147,3 +147,19 @@ int gs_opt_speeds(const char* name, const char* arg, double* v) {
   }
   return n;
 }
+
+int gs_opt_solve_limit(int c, const char* arg, const char** word) {
+  int k;
+  double x;
+  *word = arg;
+  if (c == 'n') return gs_opt_int("--nodes", arg, GS_MIN_NODES, GS_MAX_NODES, &k);
+  if (c == 'T') return gs_opt_real("--max-time", arg, 0, HUGE_VAL, GS_OPT_LO_OPEN, &x);
+  return gs_opt_int("--max-iter", arg, 0, GS_OPT_NO_MAX, &k);
+}
+
+int gs_opt_one_operand(const char* cmd, const char* what, int argc, char** argv) {
+  if (optind == argc) return gs_opt_usage_error(cmd, "missing %s", what);
+  if (optind < argc - 1)
+    return gs_opt_usage_error(cmd, "unexpected argument '%s'", argv[optind + 1]);
+  return 0;
+}

@@ -36,10 +36,19 @@ int gs_opt_choice(const char* name, const char* arg, const char* const* choices,
 // GS_MAX_SPEEDS, into v (ascending); the count, or -1 after printing.
 int gs_opt_speeds(const char* name, const char* arg, double* v);
 
+// The limits sweep and run pass on to each solve as words: c 'n' (--nodes, GS_MIN_NODES..
+// GS_MAX_NODES), 'T' (--max-time, s > 0) or 'i' (--max-iter >= 0). Checks arg and points *word
+// at it; 0, or -1 after printing.
+int gs_opt_solve_limit(int c, const char* arg, const char** word);
+
 // After getopt_long returned '?' or ':' (the caller set opterr = 0 and starts its optstring with
 // ':'): print "gaitsim: CMD: unknown option '--foo' (see gaitsim CMD --help)" or "option
 // '--nodes' needs a value" and return GS_EXIT_USAGE.
 int gs_opt_getopt_error(const char* cmd, int c, char** argv);
+
+// The one operand (e.g. TRIAL_DIR) after the options: 0 when argv[optind] is the last word,
+// else GS_EXIT_USAGE after "gaitsim: CMD: missing WHAT" or "unexpected argument 'X'".
+int gs_opt_one_operand(const char* cmd, const char* what, int argc, char** argv);
 
 // Print "gaitsim: CMD: REASON (see gaitsim CMD --help)" (printf-style reason) and return
 // GS_EXIT_USAGE.

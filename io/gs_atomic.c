@@ -238,16 +238,20 @@ static int mkdir_one(const char* dir, const char* full, char* err, int errsz) {
   return -1;
 }
 
-int gs_mkdir_p(const char* path, char* err, int errsz) {
+// a malloc'ed copy of a non-empty path, or NULL with the reason (fn: the caller's name)
+static char* path_copy(const char* path, const char* fn, char* err, int errsz) {
   if (!path || !path[0]) {
-    gs_error_set(err, errsz, "gs_mkdir_p: empty path");
-    return -1;
+    gs_error_set(err, errsz, "%s: empty path", fn);
+    return NULL;
   }
   char* buf = gs_string_dup(path);
-  if (!buf) {
-    gs_error_set(err, errsz, "%s: out of memory", path);
-    return -1;
-  }
+  if (!buf) gs_error_set(err, errsz, "%s: out of memory", path);
+  return buf;
+}
+
+int gs_mkdir_p(const char* path, char* err, int errsz) {
+  char* buf = path_copy(path, "gs_mkdir_p", err, errsz);
+  if (!buf) return -1;
 
   // create each prefix that ends before a '/', then the whole path
   for (char* p = buf + 1; *p; p++) {
@@ -273,13 +277,18 @@ int gs_mkdir_p(const char* path, char* err, int errsz) {
 static char g_staging[4096];
 static volatile sig_atomic_t g_staging_set = 0;
 
+// lstat path: 1 it exists, 0 it does not, -1 another error (with the reason)
+static int lstat_entry(const char* path, struct stat* st, char* err, int errsz) {
+  if (lstat(path, st) == 0) return 1;
+  if (errno == ENOENT) return 0;
+  gs_error_set(err, errsz, "%s: %s", path, strerror(errno));
+  return -1;
+}
+
 int gs_remove_tree(const char* path, char* err, int errsz) {
   struct stat st;
-  if (lstat(path, &st) != 0) {
-    if (errno == ENOENT) return 0;
-    gs_error_set(err, errsz, "%s: %s", path, strerror(errno));
-    return -1;
-  }
+  int exists = lstat_entry(path, &st, err, errsz);
+  if (exists <= 0) return exists;
   if (!S_ISDIR(st.st_mode)) {
     if (unlink(path) != 0) {
       gs_error_set(err, errsz, "%s: cannot remove: %s", path, strerror(errno));
@@ -317,11 +326,8 @@ int gs_remove_tree(const char* path, char* err, int errsz) {
 
 int gs_folder_replaceable(const char* path, const char* marker, char* err, int errsz) {
   struct stat st;
-  if (lstat(path, &st) != 0) {
-    if (errno == ENOENT) return 0;
-    gs_error_set(err, errsz, "%s: %s", path, strerror(errno));
-    return -1;
-  }
+  int exists = lstat_entry(path, &st, err, errsz);
+  if (exists <= 0) return exists;
   if (!S_ISDIR(st.st_mode)) {
     gs_error_set(err, errsz, "%s: exists and is not a folder", path);
     return -1;
@@ -378,16 +384,9 @@ static char* first_missing(const char* path) {
 
 int gs_folder_begin(gsFolderTx* tx, const char* path, char* err, int errsz) {
   tx->path = tx->staging = tx->made = NULL;
-  if (!path || !path[0]) {
-    gs_error_set(err, errsz, "gs_folder_begin: empty path");
-    return -1;
-  }
   // the parent folder, created when missing (and removed again on abort)
-  char* trimmed = gs_string_dup(path);
-  if (!trimmed) {
-    gs_error_set(err, errsz, "%s: out of memory", path);
-    return -1;
-  }
+  char* trimmed = path_copy(path, "gs_folder_begin", err, errsz);
+  if (!trimmed) return -1;
   for (size_t n = strlen(trimmed); n > 1 && trimmed[n - 1] == '/'; n--) trimmed[n - 1] = '\0';
   tx->path = trimmed;
   char* parent = dir_of(trimmed);

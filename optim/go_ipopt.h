@@ -61,7 +61,7 @@ typedef enum {
   GO_SOLVE_MAX_ITER,           // iteration limit
   GO_SOLVE_MAX_WALL_TIME,      // our wall-clock limit
   GO_SOLVE_MAX_CPU_TIME,       // Ipopt's max_cpu_time
-  GO_SOLVE_INTERRUPTED,        // SIGINT or go_ipopt_request_stop()
+  GO_SOLVE_INTERRUPTED,        // a stop signal (SIGINT, SIGTERM, SIGHUP) or go_ipopt_request_stop()
   GO_SOLVE_INFEASIBLE,         // locally infeasible
   GO_SOLVE_SMALL_STEP,         // search direction too small
   GO_SOLVE_DIVERGING,          // iterates diverging

@@ -87,26 +87,35 @@ static unsigned char* render_at(grRenderer* r, const grMotion* mo, double at) {
   return rgb;
 }
 
+// the model, the fixture motion and a renderer of w x h with o's other fields; 0 on success
+// (then free all three), else nothing is left to free
+static int open_fixture(int w, int h, grOptions* o, mjModel** m, grMotion* mo, grRenderer* r) {
+  char err[1024];
+  *m = gs_model_load(MODEL, err, sizeof(err));
+  EXPECT_TRUE(*m != NULL);
+  if (!*m) return -1;
+  EXPECT_EQ_INT(0, load_fixture(*m, mo));
+  o->width = w;
+  o->height = h;
+  if (gr_renderer_create(*m, o, r, err, sizeof(err)) != 0) {
+    fprintf(stderr, "renderer: %s\n", err);
+    EXPECT_TRUE(0);
+    gr_motion_free(mo);
+    mj_deleteModel(*m);
+    return -1;
+  }
+  return 0;
+}
+
 // the fixed pose against the golden image; a different pose and a missing arrow must fail it
 static void golden_image_should_match_within_tolerance(void) {
   char err[1024];
-  mjModel* m = gs_model_load(MODEL, err, sizeof(err));
-  EXPECT_TRUE(m != NULL);
-  if (!m) return;
+  mjModel* m;
   grMotion mo;
-  EXPECT_EQ_INT(0, load_fixture(m, &mo));
   grOptions o;
-  gr_options_default(&o);
-  o.width = 160;
-  o.height = 120;
   grRenderer r;
-  if (gr_renderer_create(m, &o, &r, err, sizeof(err)) != 0) {
-    fprintf(stderr, "renderer: %s\n", err);
-    EXPECT_TRUE(0);
-    gr_motion_free(&mo);
-    mj_deleteModel(m);
-    return;
-  }
+  gr_options_default(&o);
+  if (open_fixture(160, 120, &o, &m, &mo, &r) != 0) return;
   unsigned char* img = render_at(&r, &mo, 0.35);  // first frame: the command's call sequence
   EXPECT_TRUE(img != NULL);
   if (getenv("GAITSIM_UPDATE_GOLDEN")) {
@@ -327,27 +336,15 @@ static int near_mask(const unsigned char* mask, int w, int h, double u, double v
 // tendons hidden. Moved 0.4 m forward (world +x) the anchors land on the body at most a third
 // of the time, so a wrong camera, pose or projection fails it.
 static void joint_positions_should_project_onto_the_body(void) {
-  char err[1024];
-  mjModel* m = gs_model_load(MODEL, err, sizeof(err));
-  EXPECT_TRUE(m != NULL);
-  if (!m) return;
+  mjModel* m;
   grMotion mo;
-  EXPECT_EQ_INT(0, load_fixture(m, &mo));
   grOptions o;
+  grRenderer r;
   gr_options_default(&o);
-  o.width = 320;
-  o.height = 240;
   o.overlay = 0;
   o.grf_scale = 0;
   o.knee_scale = 0;
-  grRenderer r;
-  if (gr_renderer_create(m, &o, &r, err, sizeof(err)) != 0) {
-    fprintf(stderr, "renderer: %s\n", err);
-    EXPECT_TRUE(0);
-    gr_motion_free(&mo);
-    mj_deleteModel(m);
-    return;
-  }
+  if (open_fixture(320, 240, &o, &m, &mo, &r) != 0) return;
   unsigned char* img = render_at(&r, &mo, 0.35);
   mj_kinematics(m, r.d);
   int nj = 0, on = 0, on_moved = 0, inside = 0;

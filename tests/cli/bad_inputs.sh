@@ -7,7 +7,8 @@
 # temporary folder left beside it. Then the faults: disk full on a small tmpfs (skipped loudly
 # when no tmpfs can be mounted), SIGINT, SIGTERM and SIGHUP in the middle of a planar solve
 # (exit 3, status "interrupted", the folder complete), two SIGTERMs (the process ends by the
-# signal, the earlier result untouched), a stale folder, truncated and inconsistent files.
+# signal, the earlier result untouched), SIGTERM to a sweep (both chains stop and write), a stale
+# folder, truncated and inconsistent files.
 # The solves use the planar model mjmodels/gait2d.xml (seconds).
 # usage: bad_inputs.sh GAITSIM SOURCE_DIR
 set -u
@@ -246,6 +247,32 @@ status=$?
 check "two SIGTERMs: ended by SIGTERM (status $status)" test "$status" -eq 143
 check "two SIGTERMs: the earlier result untouched" test "$before" = "$(snap twice)"
 check "two SIGTERMs: no temporary folder" no_tmp twice
+
+# sweep: one SIGTERM reaches both chains (the second process gets it from the first); each
+# writes its interrupted solve, no further speed starts, the table is written, exit 3
+read -r down1 down2 up1 up2 < <(/usr/bin/python3 -c '
+import json, sys; v = json.load(open(sys.argv[1]))["speed_mps"]
+print("%.2f %.2f %.2f %.2f" % (v - 0.3, v - 0.4, v + 0.3, v + 0.4))' sol/summary.json)
+"$gaitsim" sweep --guess sol --speeds "$down2,$down1,$up1,$up2" --out sw --nodes 10 \
+  --max-iter 3000 >sw.out 2>sw.err &
+pid=$!
+for i in $(seq 300); do
+  if [ "$(cat sw/*.log 2>/dev/null | grep -c '^iter    5 ')" -ge 2 ]; then break; fi
+  sleep 0.1
+done
+kill -TERM $pid
+wait $pid
+status=$?
+check "sweep SIGTERM: exit 3 (got $status)" test "$status" -eq 3
+for v in $down1 $up1; do
+  v=$(/usr/bin/python3 -c 'import sys; print("%.4g" % float(sys.argv[1]))' "$v")
+  check "sweep SIGTERM: predict_$v interrupted and written" \
+    grep -q '"status":[[:space:]]*"interrupted"' "sw/predict_$v/summary.json"
+done
+check "sweep SIGTERM: the further speeds not started ($(ls sw | tr '\n' ' '))" \
+  test "$(ls -d sw/predict_* | wc -l)" -eq 2
+check "sweep SIGTERM: the table has the 4 speeds" test "$(($(wc -l <sw/sweep.csv) - 1))" -eq 4
+check "sweep SIGTERM: no temporary folder" no_tmp sw/x
 
 # a failed solve leaves no empty folder (the parents it would have made included)
 "$gaitsim" track nowhere --model "$planar" --out new/deeper/sol --threads 1 >/dev/null 2>&1

@@ -94,9 +94,9 @@ int gs_opt_speeds(const char* name, const char* arg, double* v) {
   if (end != arg && *end == ':') {
     double step = strtod(end + 1, &end);
     double b = *end == ':' ? strtod(end + 1, &end) : NAN;
-    if (*end || !(a > 0 && a < 10) || !(step > 0) || !(b >= a && b < 10)) {
-      fprintf(stderr, "gaitsim: %s: must be A:STEP:B with 0 < A <= B < 10 and STEP > 0 m/s, or "
-              "V1,V2,... (got %s)\n", name, arg);
+    if (*end || !(a > 0 && a < 10) || !(step > 0 && step < 10) || !(b >= a && b < 10)) {
+      fprintf(stderr, "gaitsim: %s: must be A:STEP:B with 0 < A <= B < 10 and 0 < STEP < 10 m/s, "
+              "or V1,V2,... (got %s)\n", name, arg);
       return -1;
     }
     double count = floor((b - a) / step + 1e-9) + 1;

@@ -97,6 +97,8 @@ expect "predict --stride-time 3" 2 '^gaitsim: --stride-time: must be a number in
 expect "predict without --speed" 2 '^gaitsim: predict: missing --speed V' keep "$G" "${P[@]}"
 expect "sweep --speeds 0.1:0.0001:100" 2 '^gaitsim: --speeds: must be A:STEP:B .*\(got 0\.1:0\.0001:100\)$' \
   keep "$G" sweep --guess sol --speeds 0.1:0.0001:100 --out keep
+expect "sweep --speeds 4:1e999:6 (an infinite step)" 2 '^gaitsim: --speeds: must be A:STEP:B .*\(got 4:1e999:6\)$' \
+  keep "$G" sweep --guess sol --speeds 4:1e999:6 --out keep
 expect "sweep --speeds 0.1:0.001:5 (4901 speeds)" 2 '^gaitsim: --speeds: at most 64 speeds' keep \
   "$G" sweep --guess sol --speeds 0.1:0.001:5 --out keep
 expect "sweep --speeds 1,1.00001" 2 '^gaitsim: --speeds: speeds .* the same to 4 digits' keep \

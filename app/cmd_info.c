@@ -8,6 +8,7 @@
 #include <mujoco/mujoco.h>
 
 #include "app/gs_commands.h"
+#include "app/gs_options.h"
 #include "callbacks/gs_model_info.h"
 #include "callbacks/gs_model_layout.h"
 #include "callbacks/gs_mujoco.h"
@@ -109,24 +110,16 @@ int gs_cmd_info(int argc, char** argv) {
       {"json", no_argument, NULL, 'j'}, {"help", no_argument, NULL, 'h'}, {NULL, 0, NULL, 0}};
   int json = 0;
   optind = 1;
+  opterr = 0;
   int c;
-  while ((c = getopt_long(argc, argv, "jh", options, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, ":jh", options, NULL)) != -1) {
     switch (c) {
-      case 'j':
-        json = 1;
-        break;
-      case 'h':
-        fputs(kInfoUsage, stdout);
-        return GS_EXIT_OK;
-      default:
-        fputs(kInfoUsage, stderr);
-        return GS_EXIT_USAGE;
+      case 'j': json = 1; break;
+      case 'h': fputs(kInfoUsage, stdout); return GS_EXIT_OK;
+      default: return gs_opt_getopt_error("info", c, argv);
     }
   }
-  if (optind != argc - 1) {
-    fputs(kInfoUsage, stderr);
-    return GS_EXIT_USAGE;
-  }
+  if (gs_opt_one_operand("info", "MODEL", argc, argv) != 0) return GS_EXIT_USAGE;
   const char* path = argv[optind];
   char err[1024];
   mjModel* m = gs_model_load(path, err, sizeof(err));

@@ -10,6 +10,7 @@
 
 #include "app/gs_app_model.h"
 #include "app/gs_commands.h"
+#include "app/gs_options.h"
 #include "callbacks/gs_model_info.h"
 #include "callbacks/gs_muscle.h"
 #include "callbacks/gs_physics.h"
@@ -34,25 +35,20 @@ int gs_cmd_inspect(int argc, char** argv) {
   const char* pose = NULL;
   double time = NAN, activation = 0.05;
   optind = 1;
-  int c;
-  char* end;
-  while ((c = getopt_long(argc, argv, "p:t:a:h", options, NULL)) != -1) {
+  opterr = 0;
+  int c, bad = 0;
+  while (!bad && (c = getopt_long(argc, argv, ":p:t:a:h", options, NULL)) != -1) {
     switch (c) {
       case 'p': pose = optarg; break;
-      case 't': time = strtod(optarg, &end); if (*end || end == optarg) c = '?'; break;
-      case 'a': activation = strtod(optarg, &end); if (*end || end == optarg) c = '?'; break;
+      case 't': bad = gs_opt_real("--time", optarg, -HUGE_VAL, HUGE_VAL, 0, &time); break;
+      case 'a': bad = gs_opt_real("--activation", optarg, 0, 1, 0, &activation); break;
       case 'h': fputs(kInspectUsage, stdout); return GS_EXIT_OK;
-      default: break;
-    }
-    if (c == '?') {
-      fputs(kInspectUsage, stderr);
-      return GS_EXIT_USAGE;
+      default: return gs_opt_getopt_error("inspect", c, argv);
     }
   }
-  if (optind != argc - 1 || !pose || activation < 0 || activation > 1) {
-    fputs(kInspectUsage, stderr);
-    return GS_EXIT_USAGE;
-  }
+  if (bad) return GS_EXIT_USAGE;
+  if (gs_opt_one_operand("inspect", "MODEL", argc, argv) != 0) return GS_EXIT_USAGE;
+  if (!pose) return gs_opt_usage_error("inspect", "missing --pose FILE");
   const char* path = argv[optind];
   mjModel* m = gs_app_load_model(path);
   if (!m) {
@@ -66,9 +62,9 @@ int gs_cmd_inspect(int argc, char** argv) {
   if (gs_app_read_table(m, pose, &t) != 0) {
     goto done;
   }
-  if (gs_state_map(m, &t, &map, err, sizeof(err)) != 0 || map.nq_found == 0) {
-    fprintf(stderr, "gaitsim: %s: %s\n", pose,
-            map.qpos_col ? "no column names a coordinate of the model" : err);
+  if (gs_app_require_coordinates(m, &t, pose) != 0) goto done;
+  if (gs_state_map(m, &t, &map, err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s: %s\n", pose, err);
     goto done;
   }
   if (isnan(time)) {

@@ -12,6 +12,7 @@
 
 #include "app/gs_app_model.h"
 #include "app/gs_commands.h"
+#include "app/gs_options.h"
 #include "callbacks/gs_mujoco.h"
 #include "render/gr_image.h"
 #include "render/gr_render.h"
@@ -39,25 +40,22 @@ static const char* kRenderUsage =
     "  --quality Q        fast (default) or high (shadows, reflections, 4x multisampling)\n"
     "  --no-overlay       no time / % cycle text\n";
 
-// "WxH" -> w, h (16..8192)
+// --size "WxH" -> w, h (16..8192 each); prints the reason
 static int parse_size(const char* s, int* w, int* h) {
   char* end;
   long a = strtol(s, &end, 10);
-  if (end == s || (*end != 'x' && *end != 'X')) return -1;
-  const char* s2 = end + 1;
-  long b = strtol(s2, &end, 10);
-  if (end == s2 || *end || a < 16 || b < 16 || a > 8192 || b > 8192) return -1;
+  long b = -1;
+  if (end != s && (*end == 'x' || *end == 'X')) {
+    const char* s2 = end + 1;
+    b = strtol(s2, &end, 10);
+    if (end == s2 || *end) b = -1;
+  }
+  if (b < 16 || a < 16 || a > 8192 || b > 8192) {
+    fprintf(stderr, "gaitsim: --size: must be WxH, each an integer in 16..8192 (got %s)\n", s);
+    return -1;
+  }
   *w = (int)a;
   *h = (int)b;
-  return 0;
-}
-
-// positive int option
-static int parse_count(const char* s, int lo, int hi, int* out) {
-  char* end;
-  long v = strtol(s, &end, 10);
-  if (end == s || *end || v < lo || v > hi) return -1;
-  *out = (int)v;
   return 0;
 }
 
@@ -98,10 +96,12 @@ int gs_cmd_render(int argc, char** argv) {
   int count = 8, fps = 60, cycles = 1, have_size = 0, bad = 0;
   grOptions ro;
   gr_options_default(&ro);
+  static const char* const cameras[] = {"side", "front", "follow", NULL};
+  static const char* const qualities[] = {"fast", "high", NULL};
   optind = 1;
-  int c;
-  char* end;
-  while ((c = getopt_long(argc, argv, "h", options, NULL)) != -1) {
+  opterr = 0;
+  int c, k = 0;
+  while (!bad && (c = getopt_long(argc, argv, ":h", options, NULL)) != -1) {
     switch (c) {
       case 'o': out = optarg; break;
       case 'F': frames = optarg; break;
@@ -110,51 +110,32 @@ int gs_cmd_render(int argc, char** argv) {
       case 'm': model_path = optarg; break;
       case 'P': pose = optarg; break;
       case 'O': ro.overlay = 0; break;
-      case 'a':
-        at = strtod(optarg, &end);
-        bad = *end || end == optarg || !(at >= 0 && at <= 1);
-        break;
-      case 'n': bad = parse_count(optarg, 1, 100, &count) != 0; break;
-      case 'f': bad = parse_count(optarg, 1, 240, &fps) != 0; break;
-      case 'c': bad = parse_count(optarg, 1, 100, &cycles) != 0; break;
+      case 'a': bad = gs_opt_real("--at", optarg, 0, 1, 0, &at); break;
+      case 'n': bad = gs_opt_int("--count", optarg, 1, 100, &count); break;
+      case 'f': bad = gs_opt_int("--fps", optarg, 1, 240, &fps); break;
+      case 'c': bad = gs_opt_int("--cycles", optarg, 1, 100, &cycles); break;
       case 'S':
         bad = parse_size(optarg, &ro.width, &ro.height) != 0;
         have_size = 1;
         break;
       case 'C':
-        if (strcmp(optarg, "side") == 0) {
-          ro.camera = GR_CAMERA_SIDE;
-        } else if (strcmp(optarg, "front") == 0) {
-          ro.camera = GR_CAMERA_FRONT;
-        } else if (strcmp(optarg, "follow") == 0) {
-          ro.camera = GR_CAMERA_FOLLOW;
-        } else {
-          bad = 1;
-        }
+        bad = gs_opt_choice("--camera", optarg, cameras, &k);
+        ro.camera = k == 2 ? GR_CAMERA_FOLLOW : k == 1 ? GR_CAMERA_FRONT : GR_CAMERA_SIDE;
         break;
       case 'q':
-        if (strcmp(optarg, "fast") == 0 || strcmp(optarg, "high") == 0) {
-          ro.high_quality = strcmp(optarg, "high") == 0;
-        } else {
-          bad = 1;
-        }
+        bad = gs_opt_choice("--quality", optarg, qualities, &k);
+        ro.high_quality = !bad && k == 1;
         break;
       case 'h': fputs(kRenderUsage, stdout); return GS_EXIT_OK;
-      default: bad = 1; break;
-    }
-    if (bad) {
-      fputs(kRenderUsage, stderr);
-      return GS_EXIT_USAGE;
+      default: return gs_opt_getopt_error("render", c, argv);
     }
   }
-  int nmodes = (out || frames) + (png != NULL) + (strip != NULL);
-  if (optind != argc - 1 || nmodes != 1) {
-    if (optind == argc - 1 && nmodes != 1) {
-      fprintf(stderr, "gaitsim: render: give exactly one of --out/--frames, --png, --strip\n");
-    }
-    fputs(kRenderUsage, stderr);
+  if (bad) return GS_EXIT_USAGE;
+  if (gs_opt_one_operand("render", "SOLUTION_DIR or MODEL.xml", argc, argv) != 0)
     return GS_EXIT_USAGE;
-  }
+  int nmodes = (out || frames) + (png != NULL) + (strip != NULL);
+  if (nmodes != 1)
+    return gs_opt_usage_error("render", "give exactly one of --out/--frames, --png, --strip");
   const char* input = argv[optind];
   int bare_model = is_model_path(input);
   if (bare_model ? (pose == NULL || model_path != NULL) : pose != NULL) {
@@ -197,10 +178,17 @@ int gs_cmd_render(int argc, char** argv) {
                       : gs_app_solution_model(input, solved_with, (int)sizeof(solved_with))
                           ? solved_with
                           : GS_DEFAULT_MODEL;
-  char err[1024];
+  char err[1024], states[4200];
+  if (!bare_model && gs_app_check_solution(input, 0) != 0) return GS_EXIT_FAILURE;
   mjModel* m = gs_model_load(mpath, err, sizeof(err));
   if (!m) {
     fprintf(stderr, "gaitsim: %s: %s\n", mpath, err);
+    return GS_EXIT_FAILURE;
+  }
+  // the motion names every coordinate of the model (a planar solution is not drawn on a 3D one)
+  snprintf(states, sizeof(states), "%s/states.sto", input);
+  if (gs_app_check_pose_file(m, bare_model ? pose : states) != 0) {
+    mj_deleteModel(m);
     return GS_EXIT_FAILURE;
   }
   grMotion mo;

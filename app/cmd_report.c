@@ -11,7 +11,9 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include "app/gs_app_model.h"
 #include "app/gs_commands.h"
+#include "app/gs_options.h"
 
 #define GS_REPORT_PYTHON "/usr/bin/python3"
 #define GS_REPORT_SCRIPT GAITSIM_SOURCE_DIR "/scripts/report.py"
@@ -46,30 +48,24 @@ int gs_cmd_report(int argc, char** argv) {
   const char* trial = NULL;
   const char* track = NULL;
   optind = 1;
+  opterr = 0;
   int c;
-  while ((c = getopt_long(argc, argv, "o:t:k:h", options, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, ":o:t:k:h", options, NULL)) != -1) {
     switch (c) {
-      case 'o':
-        out = optarg;
-        break;
-      case 't':
-        trial = optarg;
-        break;
-      case 'k':
-        track = optarg;
-        break;
-      case 'h':
-        fputs(kReportUsage, stdout);
-        return GS_EXIT_OK;
-      default:
-        fputs(kReportUsage, stderr);
-        return GS_EXIT_USAGE;
+      case 'o': out = optarg; break;
+      case 't': trial = optarg; break;
+      case 'k': track = optarg; break;
+      case 'h': fputs(kReportUsage, stdout); return GS_EXIT_OK;
+      default: return gs_opt_getopt_error("report", c, argv);
     }
   }
-  if (optind != argc - 1) {
-    fputs(kReportUsage, stderr);
-    return GS_EXIT_USAGE;
-  }
+  if (gs_opt_one_operand("report", "DIR", argc, argv) != 0) return GS_EXIT_USAGE;
+  // a solution folder (not a sweep's) is checked whole before the figures are drawn: every
+  // storage file reads, the node tables agree
+  char csv[4200];
+  snprintf(csv, sizeof(csv), "%s/sweep.csv", argv[optind]);
+  if (access(csv, F_OK) != 0 && gs_app_check_solution(argv[optind], 0) != 0)
+    return GS_EXIT_FAILURE;
 
   // the child's arguments: python3 report.py [--out D] [--trial T] [--track K] -- DIR; "--"
   // keeps a DIR that starts with '-' a folder name

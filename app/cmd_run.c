@@ -3,12 +3,16 @@
 // (gaitsim sweep, the two speeds in parallel processes), a report (figures, Table 1) and a video
 // and filmstrip of each solution.
 #include <getopt.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "app/gs_app_model.h"
 #include "app/gs_commands.h"
+#include "app/gs_options.h"
+#include "io/gs_atomic.h"
+#include "optim/go_ipopt.h"
 
 static const char* kRunUsage =
     "usage: gaitsim run [--out DIR] [--nodes N] [--threads N] [--max-iter N] [--max-time S]\n"
@@ -51,6 +55,13 @@ static int sub(gsCommandFn fn, const char* const* words) {
   return rc;
 }
 
+// after a stop signal: say what is kept, 1; else 0
+static int stopped_by_signal(const char* out) {
+  if (go_ipopt_stop_signals() == 0) return 0;
+  printf("run: stopped by a signal; the steps that finished are in %s\n", out);
+  return 1;
+}
+
 // report and pictures of the solution in dir
 static int show(const char* dir, int video) {
   char mp4[4200], strip[4200];
@@ -77,24 +88,44 @@ int gs_cmd_run(int argc, char** argv) {
   char speeds[256] = "0.8,2.0";
   int video = 1;
   optind = 1;
-  int c;
-  while ((c = getopt_long(argc, argv, "o:n:t:T:i:s:Vh", options, NULL)) != -1) {
+  opterr = 0;
+  int c, bad = 0, k;
+  double v[GS_MAX_SPEEDS];
+  // every value the steps are given is checked here, before the first solve
+  while (!bad && (c = getopt_long(argc, argv, ":o:n:t:T:i:s:Vh", options, NULL)) != -1) {
     switch (c) {
       case 'o': out = optarg; break;
-      case 'n': nodes = optarg; break;
-      case 't': threads = optarg; break;
-      case 'T': max_time = optarg; break;
-      case 'i': max_iter = optarg; break;
-      case 's': snprintf(speeds, sizeof(speeds), "%s", optarg); break;
+      case 'n': bad = gs_opt_solve_limit(c, optarg, &nodes); break;
+      case 'T': bad = gs_opt_solve_limit(c, optarg, &max_time); break;
+      case 'i': bad = gs_opt_solve_limit(c, optarg, &max_iter); break;
+      case 't':
+        threads = optarg;
+        bad = gs_opt_int("--threads", optarg, 1, 64, &k);
+        break;
+      case 's':
+        bad = gs_opt_speeds("--speeds", optarg, v) < 0;
+        if (!bad && snprintf(speeds, sizeof(speeds), "%s", optarg) >= (int)sizeof(speeds)) {
+          fprintf(stderr, "gaitsim: --speeds: at most %d characters\n", (int)sizeof(speeds) - 1);
+          bad = 1;
+        }
+        break;
       case 'V': video = 0; break;
       case 'h': fputs(kRunUsage, stdout); return GS_EXIT_OK;
-      default: fputs(kRunUsage, stderr); return GS_EXIT_USAGE;
+      default: return gs_opt_getopt_error("run", c, argv);
     }
   }
-  if (optind != argc) {
-    fputs(kRunUsage, stderr);
-    return GS_EXIT_USAGE;
+  if (bad) return GS_EXIT_USAGE;
+  if (optind != argc) return gs_opt_usage_error("run", "unexpected argument '%s'", argv[optind]);
+  // the solution folders it replaces must be earlier results (summary.json) or absent
+  char err[1024], sub_dir[4200];
+  for (int i = 0; i < 2; i++) {
+    snprintf(sub_dir, sizeof(sub_dir), "%s/%s", out, i ? "track_n20" : "track");
+    if (gs_folder_replaceable(sub_dir, "summary.json", err, sizeof(err)) != 0) {
+      fprintf(stderr, "gaitsim: %s\n", err);
+      return GS_EXIT_FAILURE;
+    }
   }
+  go_ipopt_install_stop_signals(gs_folder_abort_from_signal);
   const char* trial = GAITSIM_SOURCE_DIR "/mjmodels/trials/jw_ngait_og5";
   char coarse[4096], track[4096];
   snprintf(coarse, sizeof(coarse), "%s/track_n20", out);
@@ -110,6 +141,7 @@ int gs_cmd_run(int argc, char** argv) {
   rc = sub(gs_cmd_track, w1);
   if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
   stopped_short |= rc == GS_EXIT_STOPPED_SHORT;
+  if (stopped_by_signal(out)) return GS_EXIT_STOPPED_SHORT;
   if (continued) {
     printf("[1] tracking solve, %s nodes, started from it -> %s\n", nodes, track);
     const char* w2[] = {"track", trial, "--out", track, "--nodes", nodes, "--threads", threads,
@@ -117,6 +149,7 @@ int gs_cmd_run(int argc, char** argv) {
     rc = sub(gs_cmd_track, w2);
     if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
     stopped_short |= rc == GS_EXIT_STOPPED_SHORT;
+    if (stopped_by_signal(out)) return GS_EXIT_STOPPED_SHORT;
   }
 
   // 2. predictions (gaitsim sweep): each speed from the nearest one solved, for the default
@@ -131,7 +164,7 @@ int gs_cmd_run(int argc, char** argv) {
   rc = sub(gs_cmd_sweep, w3);
   if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
   stopped_short |= rc == GS_EXIT_STOPPED_SHORT;
-  double v[16];
+  if (stopped_by_signal(out)) return GS_EXIT_STOPPED_SHORT;
   int nv = 0;
   FILE* f = NULL;
   char csv[4200];
@@ -139,18 +172,20 @@ int gs_cmd_run(int argc, char** argv) {
   if ((f = fopen(csv, "r")) != NULL) {
     char line[512];
     if (fgets(line, sizeof(line), f))  // header
-      while (nv < 16 && fgets(line, sizeof(line), f)) v[nv++] = strtod(line, NULL);
+      while (nv < GS_MAX_SPEEDS && fgets(line, sizeof(line), f)) v[nv++] = strtod(line, NULL);
     fclose(f);
   }
-  char dirs[16][4200];
+  static char dirs[GS_MAX_SPEEDS][4200];
   int ndir = 0;
   for (int i = 0; i < nv; i++) snprintf(dirs[ndir++], sizeof(dirs[0]), "%s/predict_%.4g", sweep_dir, v[i]);
   // 3, 4. report and pictures
   printf("[3] report%s of %s\n", video ? ", video and filmstrip" : "", track);
   if ((rc = show(track, video)) != GS_EXIT_OK) return rc;
+  if (stopped_by_signal(out)) return GS_EXIT_STOPPED_SHORT;
   for (int i = 0; i < ndir; i++) {
     printf("[3] report%s of %s\n", video ? ", video and filmstrip" : "", dirs[i]);
     if ((rc = show(dirs[i], video)) != GS_EXIT_OK) return rc;
+    if (stopped_by_signal(out)) return GS_EXIT_STOPPED_SHORT;
   }
   // the speeds side by side (Lin, Walter & Pandy 2018, Fig. 4-6 and 8 style)
   printf("[3] report of the sweep %s\n", sweep_dir);

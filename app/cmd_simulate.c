@@ -11,6 +11,7 @@
 
 #include "app/gs_app_model.h"
 #include "app/gs_commands.h"
+#include "app/gs_options.h"
 #include "callbacks/gs_model_info.h"
 #include "callbacks/gs_physics.h"
 #include "callbacks/gs_state.h"
@@ -45,6 +46,11 @@ typedef struct gsSimulateOptions_ {
   int hold;                 // 1: lock non-pelvis joints
 } gsSimulateOptions;
 
+// at most this many output rows (duration x rate): a table of 10^6 rows of the full-body model's
+// states is about 1 GB
+#define GS_SIMULATE_MAX_ROWS 1e6
+
+// the options into o; 0, -1 after --help (usage on stdout), else GS_EXIT_USAGE after one line
 static int parse(int argc, char** argv, gsSimulateOptions* o) {
   static const struct option options[] = {
       {"out", required_argument, NULL, 'o'},        {"init", required_argument, NULL, 'i'},
@@ -54,38 +60,33 @@ static int parse(int argc, char** argv, gsSimulateOptions* o) {
       {"help", no_argument, NULL, 'h'},              {NULL, 0, NULL, 0}};
   *o = (gsSimulateOptions){NULL, NULL, NULL, NULL, 0.05, 1.0, 0.0, 100.0, 0};
   optind = 1;
-  int c;
-  char* end;
-  while ((c = getopt_long(argc, argv, "o:i:x:e:d:z:r:Hh", options, NULL)) != -1) {
-    double* target = NULL;
+  opterr = 0;
+  int c, bad = 0;
+  while (!bad && (c = getopt_long(argc, argv, ":o:i:x:e:d:z:r:Hh", options, NULL)) != -1) {
     switch (c) {
       case 'o': o->out = optarg; break;
       case 'i': o->init = optarg; break;
       case 'x': o->excitations = optarg; break;
-      case 'e': target = &o->excitation; break;
-      case 'd': target = &o->duration; break;
-      case 'z': target = &o->drop; break;
-      case 'r': target = &o->rate; break;
+      case 'e': bad = gs_opt_real("--excitation", optarg, 0, 1, 0, &o->excitation); break;
+      case 'd':
+        bad = gs_opt_real("--duration", optarg, 0, 3600, GS_OPT_LO_OPEN, &o->duration);
+        break;
+      case 'z': bad = gs_opt_real("--drop", optarg, -10, 10, 0, &o->drop); break;
+      case 'r': bad = gs_opt_real("--rate", optarg, 0, 1e5, GS_OPT_LO_OPEN, &o->rate); break;
       case 'H': o->hold = 1; break;
-      case 'h': fputs(kSimulateUsage, stdout); exit(GS_EXIT_OK);
-      default: return -1;
-    }
-    if (target) {
-      *target = strtod(optarg, &end);
-      if (*end || end == optarg || !isfinite(*target)) {
-        fprintf(stderr, "gaitsim: simulate: not a number: '%s'\n", optarg);
-        return -1;
-      }
+      case 'h': fputs(kSimulateUsage, stdout); return -1;
+      default: return gs_opt_getopt_error("simulate", c, argv);
     }
   }
-  if (optind != argc - 1 || !o->out) {
-    return -1;
+  if (bad) return GS_EXIT_USAGE;
+  if (gs_opt_one_operand("simulate", "MODEL", argc, argv) != 0) return GS_EXIT_USAGE;
+  if (!o->out) return gs_opt_usage_error("simulate", "missing --out DIR");
+  if (o->duration * o->rate > GS_SIMULATE_MAX_ROWS) {
+    fprintf(stderr, "gaitsim: --duration, --rate: at most %.0g output rows (got %g s x %g Hz)\n",
+            GS_SIMULATE_MAX_ROWS, o->duration, o->rate);
+    return GS_EXIT_USAGE;
   }
   o->model = argv[optind];
-  if (o->excitation < 0 || o->excitation > 1 || o->duration <= 0 || o->rate <= 0) {
-    fprintf(stderr, "gaitsim: simulate: excitation must lie in [0, 1], duration and rate > 0\n");
-    return -1;
-  }
   return 0;
 }
 
@@ -142,8 +143,7 @@ static int initial_state(const mjModel* m, mjData* d, const gsSimulateOptions* o
       gs_table_free(&init);
       return -1;
     }
-    if (map.nq_found == 0) {
-      fprintf(stderr, "gaitsim: %s: no column names a coordinate of the model\n", o->init);
+    if (gs_app_require_coordinates(m, &init, o->init) != 0) {
       gs_state_map_free(&map);
       gs_table_free(&init);
       return -1;
@@ -185,15 +185,20 @@ static void hold_joints(mjModel* m, const mjData* d) {
 
 int gs_cmd_simulate(int argc, char** argv) {
   gsSimulateOptions o;
-  if (parse(argc, argv, &o) != 0) {
-    fputs(kSimulateUsage, stderr);
-    return GS_EXIT_USAGE;
+  int prc = parse(argc, argv, &o);
+  if (prc != 0) return prc < 0 ? GS_EXIT_OK : prc;
+  char err[1024];
+  // an existing --out is replaced only when it holds an earlier result (its states.sto)
+  if (gs_folder_replaceable(o.out, "states.sto", err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s\n", err);
+    return GS_EXIT_FAILURE;
   }
   mjModel* m = gs_app_load_model(o.model);
   if (!m) {
     return GS_EXIT_FAILURE;
   }
   int status = GS_EXIT_FAILURE;
+  gsFolderTx tx = {NULL, NULL, NULL};
   mjData* d = mj_makeData(m);
   gsTable excitations, states, grf, forces;
   gs_table_init(&excitations);
@@ -202,7 +207,6 @@ int gs_cmd_simulate(int argc, char** argv) {
   gs_table_init(&forces);
   gsStateMap xmap = {0};
   mjtNum* fT_dot = (mjtNum*)calloc((size_t)m->nu + 1, sizeof(mjtNum));
-  char err[1024];
   if (initial_state(m, d, &o) != 0) {
     goto done;
   }
@@ -219,8 +223,9 @@ int gs_cmd_simulate(int argc, char** argv) {
   if (o.hold) {
     hold_joints(m, d);
   }
-  if (gs_mkdir_p(o.out, err, sizeof(err)) != 0) {
-    fprintf(stderr, "gaitsim: %s: %s\n", o.out, err);
+  // written into a temporary folder beside --out that replaces it at the end
+  if (gs_folder_begin(&tx, o.out, err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s\n", err);
     goto done;
   }
 
@@ -270,9 +275,13 @@ int gs_cmd_simulate(int argc, char** argv) {
     }
   }
   states.nrow = grf.nrow = forces.nrow = row;  // rows actually filled
-  if (gs_app_write_table(o.out, "states.sto", &states) != 0 ||
-      gs_app_write_table(o.out, "grf.mot", &grf) != 0 ||
-      gs_app_write_table(o.out, "muscle_forces.sto", &forces) != 0) {
+  if (gs_app_write_table(tx.staging, "states.sto", &states) != 0 ||
+      gs_app_write_table(tx.staging, "grf.mot", &grf) != 0 ||
+      gs_app_write_table(tx.staging, "muscle_forces.sto", &forces) != 0) {
+    goto done;
+  }
+  if (gs_folder_commit(&tx, err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s\n", err);
     goto done;
   }
   if (row > 0) {
@@ -285,6 +294,7 @@ int gs_cmd_simulate(int argc, char** argv) {
   status = finite ? GS_EXIT_OK : GS_EXIT_FAILURE;
 
 done:
+  gs_folder_abort(&tx);  // nothing when committed
   free(fT_dot);
   gs_state_map_free(&xmap);
   gs_table_free(&excitations);

@@ -15,7 +15,9 @@
 
 #include "app/gs_app_model.h"
 #include "app/gs_commands.h"
+#include "app/gs_options.h"
 #include "callbacks/gs_knee.h"
+#include "callbacks/gs_model_info.h"
 #include "callbacks/gs_knee_reaction.h"
 #include "callbacks/gs_physics.h"
 #include "callbacks/gs_state.h"
@@ -117,25 +119,16 @@ static int parse_weight(const char* arg, gsTrackOptions* o) {
   double* slots[] = {&o->w_pelvis_rot, &o->w_pelvis_trans, &o->w_joint, &o->w_grf,
                      &o->w_grm,        &o->w_effort,       &o->w_accel};
   const char* eq = strchr(arg, '=');
-  if (!eq) return -1;
-  for (int i = 0; i < 7; i++) {
+  for (int i = 0; eq && i < 7; i++) {
     if (strlen(names[i]) == (size_t)(eq - arg) && strncmp(arg, names[i], (size_t)(eq - arg)) == 0) {
-      char* end;
-      double v = strtod(eq + 1, &end);
-      if (*end || end == eq + 1 || !(v >= 0) || !isfinite(v)) return -1;
-      *slots[i] = v;
-      return 0;
+      char label[64];
+      snprintf(label, sizeof(label), "--weight %s", names[i]);
+      return gs_opt_real(label, eq + 1, 0, HUGE_VAL, 0, slots[i]);
     }
   }
+  fprintf(stderr, "gaitsim: --weight: must be NAME=W, NAME one of pelvis_rot, pelvis_trans, "
+          "joint, grf, grm, effort, accel (got %s)\n", arg);
   return -1;
-}
-
-static int parse_int(const char* s, int lo, int* v) {
-  char* end;
-  long x = strtol(s, &end, 10);
-  if (*end || end == s || x < lo || x > 1000000) return -1;
-  *v = (int)x;
-  return 0;
 }
 
 // Newton iterations with the exact Hessian (go_hess_create_fd) that follow an L-BFGS tracking
@@ -144,6 +137,7 @@ static int parse_int(const char* s, int lo, int* v) {
 // refinement of the tracking solve")
 #define GS_REFINE_ITER 150
 #define GS_REFINE_WALL_S 600.0  // wall-clock cap of the refinement (s)
+#define GS_STOP_POLISH_S 30.0   // wall-clock cap of the polish after a stop signal (s)
 
 // the defaults of every option (tracking; gaitsim predict changes a few)
 static void defaults(gsTrackOptions* o) {
@@ -187,6 +181,8 @@ static void defaults(gsTrackOptions* o) {
   o->ipopt.fallback_viol = 1e-4;
 }
 
+// the options of gaitsim track into o; 0, or GS_EXIT_USAGE after one line on stderr (the usage
+// text goes to stdout for --help: -1)
 static int parse(int argc, char** argv, gsTrackOptions* o) {
   char err[256];
   static const struct option options[] = {
@@ -200,65 +196,56 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
       {"fallback-rise", required_argument, NULL, 'R'},
       {"refine", required_argument, NULL, 'r'},
       {"help", no_argument, NULL, 'h'},           {NULL, 0, NULL, 0}};
+  static const char* const hessians[] = {"lbfgs", "pqn", "exact", "gauss-newton", NULL};
+  static const char* const guesses[] = {"trial", "static", NULL};
   defaults(o);
   optind = 1;
-  int c;
-  char *end;
-  while ((c = getopt_long(argc, argv, "o:m:n:t:i:T:a:p:H:w:I:G:R:r:Ph", options, NULL)) != -1) {
+  opterr = 0;
+  int c, bad = 0, k;
+  while (!bad &&
+         (c = getopt_long(argc, argv, ":o:m:n:t:i:T:a:p:H:w:I:G:R:r:Ph", options, NULL)) != -1) {
     switch (c) {
       case 'o': o->out = optarg; break;
       case 'm': o->model = optarg; break;
-      case 'n':
-        if (parse_int(optarg, 3, &o->nodes)) return -1;
-        break;
-      case 't':
-        if (parse_int(optarg, 1, &o->threads) || o->threads > 64) return -1;
-        break;
-      case 'i':
-        if (parse_int(optarg, 0, &o->max_iter)) return -1;
-        break;
+      case 'n': bad = gs_opt_int("--nodes", optarg, GS_MIN_NODES, GS_MAX_NODES, &o->nodes); break;
+      case 't': bad = gs_opt_int("--threads", optarg, 1, 64, &o->threads); break;
+      case 'i': bad = gs_opt_int("--max-iter", optarg, 0, GS_OPT_NO_MAX, &o->max_iter); break;
       case 'T':
-        o->max_time = strtod(optarg, &end);
-        if (*end || end == optarg || !(o->max_time > 0)) return -1;
+        bad = gs_opt_real("--max-time", optarg, 0, HUGE_VAL, GS_OPT_LO_OPEN, &o->max_time);
         break;
       case 'R':
-        o->ipopt.fallback_rise = strtod(optarg, &end);
-        if (*end || end == optarg || !(o->ipopt.fallback_rise >= 0)) return -1;
+        bad = gs_opt_real("--fallback-rise", optarg, 0, HUGE_VAL, 0, &o->ipopt.fallback_rise);
         break;
-      case 'r':
-        if (parse_int(optarg, 0, &o->refine_iter)) return -1;
-        break;
-      case 'a':
-        o->activation = strtod(optarg, &end);
-        if (*end || end == optarg || !(o->activation >= 0.001 && o->activation <= 1)) return -1;
-        break;
+      case 'r': bad = gs_opt_int("--refine", optarg, 0, GS_OPT_NO_MAX, &o->refine_iter); break;
+      case 'a': bad = gs_opt_real("--activation", optarg, 0.001, 1, 0, &o->activation); break;
       case 'p':
         if (go_ipopt_opts_add(&o->ipopt, optarg, err, sizeof(err)) != 0) {
-          fprintf(stderr, "gaitsim: track: %s\n", err);
-          return -1;
+          fprintf(stderr, "gaitsim: --ipopt: %s\n", err);
+          bad = 1;
         }
         break;
       case 'H':
-        o->pqn = strcmp(optarg, "pqn") == 0;
-        o->hess_fd = strcmp(optarg, "exact") == 0;
-        o->ipopt.gauss_newton = strcmp(optarg, "gauss-newton") == 0;
-        if (!o->pqn && !o->hess_fd && !o->ipopt.gauss_newton && strcmp(optarg, "lbfgs") != 0)
-          return -1;
+        bad = gs_opt_choice("--hessian", optarg, hessians, &k);
+        o->pqn = !bad && k == 1;
+        o->hess_fd = !bad && k == 2;
+        o->ipopt.gauss_newton = !bad && k == 3;
         break;
-      case 'w':
-        if (parse_weight(optarg, o)) return -1;
-        break;
+      case 'w': bad = parse_weight(optarg, o); break;
       case 'I': o->init = optarg; break;
       case 'G':
-        o->guess_static = strcmp(optarg, "static") == 0;
-        if (!o->guess_static && strcmp(optarg, "trial") != 0) return -1;
+        bad = gs_opt_choice("--guess-method", optarg, guesses, &k);
+        o->guess_static = !bad && k == 1;
         break;
       case 'P': o->polish = 0; break;
-      case 'h': fputs(kTrackUsage, stdout); exit(GS_EXIT_OK);
-      default: return -1;
+      case 'h': fputs(kTrackUsage, stdout); return -1;
+      default: return gs_opt_getopt_error("track", c, argv);
     }
   }
-  if (optind != argc - 1 || !o->out || (o->guess_static && o->init)) return -1;
+  if (bad) return GS_EXIT_USAGE;
+  if (gs_opt_one_operand("track", "TRIAL_DIR", argc, argv) != 0) return GS_EXIT_USAGE;
+  if (!o->out) return gs_opt_usage_error("track", "missing --out DIR");
+  if (o->guess_static && o->init)
+    return gs_opt_usage_error("track", "--guess-method static and --init exclude each other");
   o->trial = argv[optind];
   return 0;
 }
@@ -746,7 +733,8 @@ static int guess_from_folder(go_gait* g, const mjModel* m, const char* dir, doub
   char path[4096], err[512];
   int rc = -1;
   snprintf(path, sizeof(path), "%s/states.sto", dir);
-  if (gs_app_read_table(m, path, &states) != 0) goto done;
+  if (gs_app_read_table(m, path, &states) != 0 || gs_app_require_coordinates(m, &states, path) != 0)
+    goto done;
   snprintf(path, sizeof(path), "%s/controls.sto", dir);
   if (gs_app_read_table(m, path, &controls) != 0) goto done;
   if (go_gait_guess_from_solution(g, &states, &controls, 1.0, activation, z, err,
@@ -835,7 +823,8 @@ static int predict_setup(const mjModel* m, gsTrackOptions* o, go_gait_opts* go, 
   char path[4096], err[512];
   int rc = -1, nv = m->nv;
   snprintf(path, sizeof(path), "%s/states.sto", o->guess);
-  if (gs_app_read_table(m, path, &states) != 0) goto done;
+  if (gs_app_read_table(m, path, &states) != 0 || gs_app_require_coordinates(m, &states, path) != 0)
+    goto done;
   snprintf(path, sizeof(path), "%s/controls.sto", o->guess);
   if (gs_app_read_table(m, path, &controls) != 0) goto done;
   *T0 = states.time[states.nrow - 1] - states.time[0];
@@ -1050,66 +1039,58 @@ int gs_cmd_predict(int argc, char** argv) {
   o.fibre_bounds = 1;
   o.min_vgrf = PREDICT_MIN_VGRF;
   optind = 1;
+  opterr = 0;
   int c, bad = 0, model_given = 0;
-  char err[256], *end;
-  while ((c = getopt_long(argc, argv, "g:s:o:m:n:t:i:T:w:PFS:R:W:D:E:p:h", options, NULL)) != -1) {
+  char err[256];
+  while (!bad && (c = getopt_long(argc, argv, ":g:s:o:m:n:t:i:T:w:PFS:R:W:D:E:p:h", options,
+                                  NULL)) != -1) {
     switch (c) {
       case 'g': o.guess = optarg; break;
-      case 's':
-        o.speed = strtod(optarg, &end);
-        bad |= *end || end == optarg || !(o.speed > 0 && o.speed < 10);
-        break;
+      case 's': bad = gs_opt_real("--speed", optarg, 0, 10, GS_OPT_LO_OPEN | GS_OPT_HI_OPEN, &o.speed); break;
       case 'o': o.out = optarg; break;
       case 'm':
         o.model = optarg;
         model_given = 1;
         break;
-      case 'n': bad |= parse_int(optarg, 3, &o.nodes); break;
-      case 't': bad |= parse_int(optarg, 1, &o.threads) || o.threads > 64; break;
-      case 'i': bad |= parse_int(optarg, 0, &o.max_iter); break;
+      case 'n': bad = gs_opt_int("--nodes", optarg, GS_MIN_NODES, GS_MAX_NODES, &o.nodes); break;
+      case 't': bad = gs_opt_int("--threads", optarg, 1, 64, &o.threads); break;
+      case 'i': bad = gs_opt_int("--max-iter", optarg, 0, GS_OPT_NO_MAX, &o.max_iter); break;
       case 'T':
-        o.max_time = strtod(optarg, &end);
-        bad |= *end || end == optarg || !(o.max_time > 0);
+        bad = gs_opt_real("--max-time", optarg, 0, HUGE_VAL, GS_OPT_LO_OPEN, &o.max_time);
         break;
-      case 'w': bad |= parse_weight(optarg, &o); break;
+      case 'w': bad = parse_weight(optarg, &o); break;
       case 'P': o.polish = 0; break;
       case 'F': o.fibre_bounds = 0; break;
-      case 'D':
-        o.stride_time = strtod(optarg, &end);
-        bad |= *end || end == optarg || !(o.stride_time >= 0.4 && o.stride_time <= 2.5);
-        break;
+      case 'D': bad = gs_opt_real("--stride-time", optarg, 0.4, 2.5, 0, &o.stride_time); break;
       case 'E':
-        o.stride_time_start = strtod(optarg, &end);
-        bad |= *end || end == optarg ||
-               !(o.stride_time_start >= 0.4 && o.stride_time_start <= 2.5);
+        bad = gs_opt_real("--stride-time-start", optarg, 0.4, 2.5, 0, &o.stride_time_start);
         break;
       case 'W':
-        o.min_vgrf = strtod(optarg, &end);
-        bad |= *end || end == optarg || !(o.min_vgrf >= 0 && o.min_vgrf < 10);
+        bad = gs_opt_real("--min-vgrf", optarg, 0, 10, GS_OPT_HI_OPEN, &o.min_vgrf);
         break;
       case 'R':
-        o.ipopt.fallback_rise = strtod(optarg, &end);
-        bad |= *end || end == optarg || !(o.ipopt.fallback_rise >= 0);
+        bad = gs_opt_real("--fallback-rise", optarg, 0, HUGE_VAL, 0, &o.ipopt.fallback_rise);
         break;
       case 'S':
-        o.metabolic_smoothing = strtod(optarg, &end);
-        bad |= *end || end == optarg ||
-               !(o.metabolic_smoothing > 0 && o.metabolic_smoothing <= 1e3);
+        bad = gs_opt_real("--metabolic-smoothing", optarg, 0, 1e3, GS_OPT_LO_OPEN,
+                          &o.metabolic_smoothing);
         break;
       case 'p':
         if (go_ipopt_opts_add(&o.ipopt, optarg, err, sizeof(err)) != 0) {
-          fprintf(stderr, "gaitsim: predict: %s\n", err);
+          fprintf(stderr, "gaitsim: --ipopt: %s\n", err);
           bad = 1;
         }
         break;
       case 'h': fputs(kPredictUsage, stdout); return GS_EXIT_OK;
-      default: bad = 1;
+      default: return gs_opt_getopt_error("predict", c, argv);
     }
   }
-  if (bad || optind != argc || !o.guess || !o.out || !(o.speed > 0)) {
-    fputs(kPredictUsage, stderr);
-    return GS_EXIT_USAGE;
-  }
+  if (bad) return GS_EXIT_USAGE;
+  if (optind != argc)
+    return gs_opt_usage_error("predict", "unexpected argument '%s'", argv[optind]);
+  if (!o.guess) return gs_opt_usage_error("predict", "missing --guess TRACK_DIR");
+  if (!(o.speed > 0)) return gs_opt_usage_error("predict", "missing --speed V");
+  if (!o.out) return gs_opt_usage_error("predict", "missing --out DIR");
   o.trial = o.guess;
   // the guess's own model unless --model: a solution continues on the model it was solved with
   static char guess_model[4096];
@@ -1120,17 +1101,37 @@ int gs_cmd_predict(int argc, char** argv) {
 
 int gs_cmd_track(int argc, char** argv) {
   gsTrackOptions o;
-  if (parse(argc, argv, &o) != 0) {
-    fputs(kTrackUsage, stderr);
-    return GS_EXIT_USAGE;
-  }
+  int rc = parse(argc, argv, &o);
+  if (rc != 0) return rc < 0 ? GS_EXIT_OK : rc;
   return solve(o);
 }
 
 // the tracking (o.predict == 0) or predictive problem: build, guess, solve, polish, write
 static int solve(gsTrackOptions o) {
+  char err[1024];
+  // stop signals: the first stops the solve (its best iterate written, exit 3), a second ends
+  // the process at once, the temporary output folder removed
+  go_ipopt_install_stop_signals(gs_folder_abort_from_signal);
+  // inputs and the output folder checked before any work: an existing --out is replaced only
+  // when it holds an earlier result (its summary.json)
+  if (gs_folder_replaceable(o.out, "summary.json", err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s\n", err);
+    return GS_EXIT_FAILURE;
+  }
+  const char* from = o.predict ? o.guess : o.init;
+  if (from && gs_app_check_solution(from, 1) != 0) return GS_EXIT_FAILURE;
   mjModel* m = gs_app_load_model(o.model);
   if (!m) return GS_EXIT_FAILURE;
+  gsModelInfo info;  // a gait needs both feet on the ground
+  gs_model_info(m, &info);
+  if (info.ncontact_r == 0 || info.ncontact_l == 0) {
+    fprintf(stderr, "gaitsim: %s: no foot contact spheres (contact_r_*: %d, contact_l_*: %d); "
+            "a gait needs both feet (gaitsim info MODEL)\n", o.model, info.ncontact_r,
+            info.ncontact_l);
+    mj_deleteModel(m);
+    return GS_EXIT_FAILURE;
+  }
+  gsFolderTx tx = {NULL, NULL, NULL};
   int status = GS_EXIT_FAILURE;
   gsTable coords, grf;
   gs_table_init(&coords);
@@ -1140,12 +1141,14 @@ static int solve(gsTrackOptions o) {
   double *z = NULL, *zb = NULL, *zs = NULL, *gv = NULL;
   cJSON* summary = NULL;
   cJSON* restarts = NULL;  // summary.json "restarts", one object per restart after a fall-back
-  char path[4096], err[1024];
+  char path[4096];
   const char* what = o.predict ? "predict" : "track";
   double grf_scale = 0, *band = NULL, T0 = 0, dx0 = 0;
   if (!o.predict) {
     snprintf(path, sizeof(path), "%s/coordinates.mot", o.trial);
-    if (gs_app_read_table(m, path, &coords) != 0) goto done;
+    if (gs_app_read_table(m, path, &coords) != 0 ||
+        gs_app_require_coordinates(m, &coords, path) != 0)
+      goto done;
     snprintf(path, sizeof(path), "%s/grf.mot", o.trial);
     if (gs_app_read_table(m, path, &grf) != 0) goto done;
     double model_weight = mj_getTotalmass(m) * mju_norm3(m->opt.gravity);
@@ -1156,8 +1159,9 @@ static int solve(gsTrackOptions o) {
       goto done;
     }
   }
-  if (gs_mkdir_p(o.out, err, sizeof(err)) != 0) {
-    fprintf(stderr, "gaitsim: %s: %s\n", o.out, err);
+  // the solution is written into a temporary folder beside --out that replaces it at the end
+  if (gs_folder_begin(&tx, o.out, err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s\n", err);
     goto done;
   }
   go_gait_opts go;
@@ -1351,6 +1355,10 @@ static int solve(gsTrackOptions o) {
     po.gauss_newton = 1;
     po.max_iter = 200;
     po.max_wall_s = o.max_time;
+    // after a stop signal, only a quick polish (a second signal ends it at once, writing nothing)
+    if (res.status == GO_SOLVE_INTERRUPTED &&
+        !(po.max_wall_s > 0 && po.max_wall_s < GS_STOP_POLISH_S))
+      po.max_wall_s = GS_STOP_POLISH_S;
     po.progress = stderr;
     po.handle_sigint = 1;
     go_ipopt_opts_set(&po, "tol", "1e-6", err, sizeof(err));
@@ -1455,16 +1463,20 @@ static int solve(gsTrackOptions o) {
   cJSON_AddNumberToObject(summary, "max_defect", max_defect);
   cJSON_AddBoolToObject(summary, "best_iterate_written", zout == zb);
   double* knee_ref = o.predict ? NULL : measured_knee_contact(o.trial, g);
-  int wrote_solution = write_solution(g, zout, o.out, knee_ref, summary);
+  int wrote_solution = write_solution(g, zout, tx.staging, knee_ref, summary);
   free(knee_ref);
   if (wrote_solution != 0) goto done;
   char* text = cJSON_Print(summary);
-  snprintf(path, sizeof(path), "%s/summary.json", o.out);
+  snprintf(path, sizeof(path), "%s/summary.json", tx.staging);
   size_t len = text ? strlen(text) : 0;
   int wrote = text && gs_atomic_write_buffer(path, text, len, err, sizeof(err)) == 0;
   free(text);
   if (!wrote) {
-    fprintf(stderr, "gaitsim: %s: %s\n", path, err);
+    fprintf(stderr, "gaitsim: %s\n", err);
+    goto done;
+  }
+  if (gs_folder_commit(&tx, err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s\n", err);
     goto done;
   }
   printf("%s: %s after %d iterations, %.1f s; max violation %.3g (from %.3g); wrote %s\n", what,
@@ -1472,6 +1484,7 @@ static int solve(gsTrackOptions o) {
   status = converged ? GS_EXIT_OK : GS_EXIT_STOPPED_SHORT;
 
 done:
+  gs_folder_abort(&tx);  // nothing when committed
   cJSON_Delete(summary);
   cJSON_Delete(restarts);
   free(z), free(zb), free(zs), free(gv), free(band);

@@ -8,6 +8,7 @@
 #include <errno.h>
 #include <getopt.h>
 #include <math.h>
+#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -18,10 +19,12 @@
 
 #include "app/gs_app_model.h"
 #include "app/gs_commands.h"
+#include "app/gs_options.h"
 #include "io/gs_atomic.h"
 #include "io/gs_storage.h"
+#include "optim/go_ipopt.h"
 
-#define SWEEP_MAX_SPEEDS 64
+#define SWEEP_MAX_SPEEDS GS_MAX_SPEEDS
 
 static const char* kSweepUsage =
     "usage: gaitsim sweep --guess TRACK_DIR --speeds LIST --out DIR [options]\n\n"
@@ -33,35 +36,6 @@ static const char* kSweepUsage =
     "  --max-time S    wall-clock limit of each solve, s (default none: the iteration limit,\n"
     "                  so that the results do not depend on the load of the machine)\n"
     "  --max-iter N    Ipopt iteration limit of each solve (default 1500)\n";
-
-// speeds from "A:STEP:B" or "V1,V2,..." into v (ascending); count, or -1 when malformed
-static int parse_speeds(const char* s, double* v) {
-  char* end;
-  double a = strtod(s, &end);
-  int n = 0;
-  if (end != s && *end == ':') {
-    double step = strtod(end + 1, &end);
-    if (*end != ':') return -1;
-    double b = strtod(end + 1, &end);
-    if (*end || !(a > 0) || !(step > 0) || !(b >= a)) return -1;
-    for (double x = a; x <= b + 1e-9 && n < SWEEP_MAX_SPEEDS; x += step) v[n++] = x;
-  } else {
-    const char* p = s;
-    while (*p && n < SWEEP_MAX_SPEEDS) {
-      v[n] = strtod(p, &end);
-      if (end == p || !(v[n] > 0) || (*end && *end != ',')) return -1;
-      n++;
-      p = *end ? end + 1 : end;
-    }
-    for (int i = 1; i < n; i++)  // insertion sort: ascending
-      for (int j = i; j > 0 && v[j] < v[j - 1]; j--) {
-        double t = v[j];
-        v[j] = v[j - 1];
-        v[j - 1] = t;
-      }
-  }
-  return n;
-}
 
 // the guess's mean speed (summary.json speed_mps), or NAN
 static double guess_speed(const char* dir) {
@@ -93,13 +67,12 @@ static double column_max(const char* dir, const char* file, const char* label) {
 // one predictive solve: speed v from guess into out, progress into out/log.txt
 static int solve_one(const char* guess, double v, const char* out, const char* nodes,
                      const char* max_time, const char* max_iter) {
-  char speed[32], err[256], log[4200];
+  char speed[32], log[4200], final_log[4200];
   snprintf(speed, sizeof(speed), "%.4g", v);
-  if (gs_mkdir_p(out, err, sizeof(err)) != 0) {
-    fprintf(stderr, "gaitsim: %s: %s\n", out, err);
-    return GS_EXIT_FAILURE;
-  }
-  snprintf(log, sizeof(log), "%s/log.txt", out);
+  // the progress goes to OUT.log while predict writes OUT whole, then into OUT/log.txt (a solve
+  // that wrote nothing leaves OUT.log)
+  snprintf(log, sizeof(log), "%s.log", out);
+  snprintf(final_log, sizeof(final_log), "%s/log.txt", out);
   fflush(stderr);
   int saved = dup(2);
   FILE* lf = fopen(log, "w");
@@ -116,6 +89,8 @@ static int solve_one(const char* guess, double v, const char* out, const char* n
     fclose(lf);
   }
   close(saved);
+  if (lf && access(out, F_OK) == 0 && rename(log, final_log) != 0)
+    fprintf(stderr, "gaitsim: %s: %s\n", final_log, strerror(errno));
   printf("sweep: %s m/s from %s: exit %d (%s)\n", speed, guess, rc, out);
   fflush(stdout);
   return rc;
@@ -128,6 +103,10 @@ static int chain(const char* guess, const double* v, const int* idx, int n, cons
   snprintf(prev, sizeof(prev), "%s", guess);
   int worst = GS_EXIT_OK;
   for (int i = 0; i < n; i++) {
+    if (go_ipopt_stop_signals() > 0) {  // stopped by a signal: what finished stays
+      printf("sweep: stopped by a signal before %.4g m/s\n", v[idx[i]]);
+      return GS_EXIT_STOPPED_SHORT;
+    }
     snprintf(out, sizeof(out), "%s/predict_%.4g", dir, v[idx[i]]);
     int rc = solve_one(prev, v[idx[i]], out, nodes, max_time, max_iter);
     if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
@@ -144,28 +123,31 @@ int gs_cmd_sweep(int argc, char** argv) {
       {"max-time", required_argument, NULL, 'T'}, {"max-iter", required_argument, NULL, 'i'},
       {"help", no_argument, NULL, 'h'},
       {NULL, 0, NULL, 0}};
-  const char *guess = NULL, *list = NULL, *dir = NULL, *nodes = "20", *max_time = NULL,
-             *max_iter = "1500";
+  const char *guess = NULL, *dir = NULL, *nodes = "20", *max_time = NULL, *max_iter = "1500";
+  double v[SWEEP_MAX_SPEEDS];
+  int n = -1, c, bad = 0;
   optind = 1;
-  int c;
-  while ((c = getopt_long(argc, argv, "g:s:o:n:T:i:h", options, NULL)) != -1) {
+  opterr = 0;
+  // every value checked here; predict gets the words as given
+  while (!bad && (c = getopt_long(argc, argv, ":g:s:o:n:T:i:h", options, NULL)) != -1) {
     switch (c) {
       case 'g': guess = optarg; break;
-      case 's': list = optarg; break;
+      case 's': bad = (n = gs_opt_speeds("--speeds", optarg, v)) < 0; break;
       case 'o': dir = optarg; break;
-      case 'n': nodes = optarg; break;
-      case 'T': max_time = optarg; break;
-      case 'i': max_iter = optarg; break;
+      case 'n': bad = gs_opt_solve_limit(c, optarg, &nodes); break;
+      case 'T': bad = gs_opt_solve_limit(c, optarg, &max_time); break;
+      case 'i': bad = gs_opt_solve_limit(c, optarg, &max_iter); break;
       case 'h': fputs(kSweepUsage, stdout); return GS_EXIT_OK;
-      default: fputs(kSweepUsage, stderr); return GS_EXIT_USAGE;
+      default: return gs_opt_getopt_error("sweep", c, argv);
     }
   }
-  double v[SWEEP_MAX_SPEEDS];
-  int n = list ? parse_speeds(list, v) : -1;
-  if (optind != argc || !guess || !dir || n < 1) {
-    fputs(kSweepUsage, stderr);
-    return GS_EXIT_USAGE;
-  }
+  if (bad) return GS_EXIT_USAGE;
+  if (optind != argc) return gs_opt_usage_error("sweep", "unexpected argument '%s'", argv[optind]);
+  if (!guess) return gs_opt_usage_error("sweep", "missing --guess TRACK_DIR");
+  if (n < 1) return gs_opt_usage_error("sweep", "missing --speeds LIST");
+  if (!dir) return gs_opt_usage_error("sweep", "missing --out DIR");
+  go_ipopt_install_stop_signals(gs_folder_abort_from_signal);
+  if (gs_app_check_solution(guess, 1) != 0) return GS_EXIT_FAILURE;
   double v0 = guess_speed(guess);
   if (!isfinite(v0)) {
     fprintf(stderr, "gaitsim: %s/summary.json: no speed_mps (not a solution folder?)\n", guess);
@@ -186,13 +168,23 @@ int gs_cmd_sweep(int argc, char** argv) {
          nu);
   fflush(stdout);
   int rc_down = GS_EXIT_OK, rc_up;
+  // stop signals reach both chains: held back until the child is registered
+  sigset_t stops, before;
+  sigemptyset(&stops);
+  sigaddset(&stops, SIGINT);
+  sigaddset(&stops, SIGTERM);
+  sigaddset(&stops, SIGHUP);
+  sigprocmask(SIG_BLOCK, &stops, &before);
   pid_t pid = nd > 0 && nu > 0 ? fork() : -1;
+  if (pid > 0) go_ipopt_forward_signals_to((long)pid, 1);
+  sigprocmask(SIG_SETMASK, &before, NULL);
   if (pid == 0) _exit(chain(guess, v, down, nd, dir, nodes, max_time, max_iter));
   rc_up = chain(guess, v, up, nu, dir, nodes, max_time, max_iter);
   if (pid > 0) {
     int st = 0;
     while (waitpid(pid, &st, 0) < 0 && errno == EINTR) {
     }
+    go_ipopt_forward_signals_to((long)pid, 0);
     rc_down = WIFEXITED(st) ? WEXITSTATUS(st) : GS_EXIT_FAILURE;
   } else if (nd > 0) {
     rc_down = chain(guess, v, down, nd, dir, nodes, max_time, max_iter);

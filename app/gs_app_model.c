@@ -1,9 +1,13 @@
 // gs_app_model.c: model preparation and table I/O shared by the subcommands.
 #include "app/gs_app_model.h"
 
+#include <errno.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <cjson/cJSON.h>
 
@@ -12,8 +16,61 @@
 #include "callbacks/gs_state.h"
 #include "io/gs_storage.h"
 
+// the whole file at path, NUL-terminated (caller frees), or NULL when it cannot be read
+static char* read_text(const char* path) {
+  FILE* f = fopen(path, "rb");
+  if (!f) return NULL;
+  char* text = NULL;
+  size_t len = 0, got;
+  char buf[8192];
+  while ((got = fread(buf, 1, sizeof(buf), f)) > 0) {
+    char* t = (char*)realloc(text, len + got + 1);
+    if (!t) {
+      free(text);
+      fclose(f);
+      return NULL;
+    }
+    text = t;
+    memcpy(text + len, buf, got);
+    len += got;
+  }
+  fclose(f);
+  if (text) text[len] = 0;
+  return text;
+}
+
+// An MJCF file must say <compiler angle="radian">: gaitsim's numbers (joint ranges, keyframes,
+// storage files converted from degrees) are radians, and MuJoCo's default is degrees, which
+// would silently turn a range of 1.5 into 1.5 degrees. 0, or -1 with err. Binary models (.mjb)
+// are compiled already.
+static int check_radians(const char* path, char* err, int errsz) {
+  size_t n = strlen(path);
+  if (n < 4 || strcmp(path + n - 4, ".xml") != 0) return 0;
+  char* text = read_text(path);
+  if (!text) return 0;  // gs_model_load reports it
+  int radian = 0, degree = 0;
+  for (const char* c = strstr(text, "<compiler"); c; c = strstr(c + 1, "<compiler")) {
+    const char* end = strchr(c, '>');
+    const char* a = strstr(c, "angle=");
+    if (!end || !a || a > end) continue;
+    a += 6;
+    char q = *a == '"' || *a == '\'' ? *a++ : 0;
+    radian |= strncmp(a, "radian", 6) == 0 && (!q || a[6] == q);
+    degree |= strncmp(a, "degree", 6) == 0 && (!q || a[6] == q);
+  }
+  free(text);
+  if (radian && !degree) return 0;
+  snprintf(err, (size_t)errsz, "angles must be in radians: <compiler angle=\"radian\"> %s",
+           degree ? "(the model says degree)" : "is missing (MuJoCo's default is degree)");
+  return -1;
+}
+
 mjModel* gs_app_load_model(const char* path) {
   char err[1024];
+  if (check_radians(path, err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s: %s\n", path, err);
+    return NULL;
+  }
   mjModel* m = gs_model_load(path, err, sizeof(err));
   if (!m) {
     fprintf(stderr, "gaitsim: %s: %s\n", path, err);
@@ -51,21 +108,8 @@ int gs_app_write_table(const char* dir, const char* name, const gsTable* t) {
 }
 
 cJSON* gs_app_read_json(const char* path) {
-  FILE* f = fopen(path, "rb");
-  if (!f) return NULL;
-  char* text = NULL;
-  size_t len = 0, got;
-  char buf[4096];
-  while ((got = fread(buf, 1, sizeof(buf), f)) > 0) {
-    char* t = (char*)realloc(text, len + got + 1);
-    if (!t) break;
-    text = t;
-    memcpy(text + len, buf, got);
-    len += got;
-  }
-  fclose(f);
+  char* text = read_text(path);
   if (!text) return NULL;
-  text[len] = 0;
   cJSON* j = cJSON_Parse(text);
   free(text);
   return j;
@@ -87,4 +131,99 @@ const char* gs_app_solution_model(const char* dir, char* buf, int n) {
   }
   cJSON_Delete(j);
   return found;
+}
+
+int gs_app_check_solution(const char* dir, int require_summary) {
+  char path[4096], err[1024];
+  struct stat st;
+  if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode)) {
+    fprintf(stderr, "gaitsim: %s: %s\n", dir,
+            stat(dir, &st) != 0 ? strerror(errno) : "not a folder");
+    return -1;
+  }
+  // summary.json: valid when present; its node count
+  snprintf(path, sizeof(path), "%s/summary.json", dir);
+  int nodes = -1;
+  if (access(path, F_OK) == 0) {
+    cJSON* j = gs_app_read_json(path);
+    if (!j) {
+      fprintf(stderr, "gaitsim: %s: unreadable or not valid JSON (an incomplete solution "
+              "folder?)\n", path);
+      return -1;
+    }
+    const cJSON* n = cJSON_GetObjectItemCaseSensitive(j, "nodes");
+    double v = cJSON_IsNumber(n) ? n->valuedouble : 1;
+    if (n && !(cJSON_IsNumber(n) && v >= 1 && v <= 1e6 && v == floor(v))) {
+      fprintf(stderr, "gaitsim: %s: \"nodes\" is not a node count\n", path);
+      cJSON_Delete(j);
+      return -1;
+    }
+    if (n) nodes = (int)v;
+    cJSON_Delete(j);
+  } else if (require_summary) {
+    fprintf(stderr, "gaitsim: %s: no summary.json: not a complete solution folder\n", dir);
+    return -1;
+  }
+  // every storage file reads; the node tables agree
+  static const char* files[] = {"states.sto", "controls.sto", "variables.sto", "grf.mot",
+                                "muscle_forces.sto", "metabolics.sto", "knee_contact.sto"};
+  int rows = nodes, rows_from = -1;  // rows_from: files[] index that set rows, -1 summary
+  for (int i = 0; i < (int)(sizeof(files) / sizeof(files[0])); i++) {
+    snprintf(path, sizeof(path), "%s/%s", dir, files[i]);
+    if (access(path, F_OK) != 0) {
+      if (i > 0) continue;
+      fprintf(stderr, "gaitsim: %s: missing: not a complete solution folder\n", path);
+      return -1;
+    }
+    gsTable t;
+    gs_table_init(&t);
+    if (gs_storage_read(path, &t, err, sizeof(err)) != 0) {
+      fprintf(stderr, "gaitsim: %s\n", err);
+      return -1;
+    }
+    int n = t.nrow;
+    gs_table_free(&t);
+    if (i > 2) continue;
+    if (rows >= 0 && n != rows) {
+      fprintf(stderr, "gaitsim: %s: %d rows, but %s %d: files of different solutions\n", path,
+              n, rows_from < 0 ? "summary.json says nodes =" : files[rows_from], rows);
+      return -1;
+    }
+    if (rows < 0) rows = n, rows_from = i;
+  }
+  return 0;
+}
+
+int gs_app_require_coordinates(const mjModel* m, const gsTable* t, const char* path) {
+  char list[512] = "";
+  int missing = 0, total = 0;
+  size_t len = 0;
+  for (int j = 0; j < m->njnt; j++) {
+    if (m->jnt_type[j] != mjJNT_HINGE && m->jnt_type[j] != mjJNT_SLIDE) continue;
+    total++;
+    const char* name = mj_id2name(m, mjOBJ_JOINT, j);
+    if (name && gs_table_column(t, name) >= 0) continue;
+    if (missing < 6 && len < sizeof(list)) {
+      len += (size_t)snprintf(list + len, sizeof(list) - len, "%s%s", missing ? ", " : "",
+                              name ? name : "(unnamed)");
+    } else if (missing == 6 && len < sizeof(list)) {
+      len += (size_t)snprintf(list + len, sizeof(list) - len, ", ...");
+    }
+    missing++;
+  }
+  if (missing == 0) return 0;
+  fprintf(stderr, "gaitsim: %s: no column for %d of the model's %d coordinates: %s\n", path,
+          missing, total, list);
+  return -1;
+}
+
+int gs_app_check_pose_file(const mjModel* m, const char* path) {
+  char err[1024];
+  gsTable t;
+  gs_table_init(&t);
+  int rc = gs_storage_read(path, &t, err, sizeof(err));
+  if (rc != 0) fprintf(stderr, "gaitsim: %s\n", err);
+  else rc = gs_app_require_coordinates(m, &t, path);
+  gs_table_free(&t);
+  return rc;
 }

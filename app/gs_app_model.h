@@ -33,4 +33,20 @@ struct cJSON* gs_app_read_json(const char* path);
 // file is gone).
 const char* gs_app_solution_model(const char* dir, char* buf, int n);
 
+// Check a solution folder before it is read (predict --guess, track --init, render, report,
+// sweep --guess): DIR is a folder with states.sto; summary.json, when present (required with
+// require_summary), is valid JSON; every storage file of the folder reads without error; and
+// states.sto, controls.sto and variables.sto have one row count, equal to summary.json's
+// "nodes" when it says. Prints one line "gaitsim: FILE: reason" and returns -1 otherwise.
+int gs_app_check_solution(const char* dir, int require_summary);
+
+// Check that table t (read from path) has a column for every coordinate (hinge or slide joint)
+// of m. Prints "gaitsim: PATH: no column for N of the model's M coordinates: a, b, ..." and
+// returns -1 otherwise.
+int gs_app_require_coordinates(const mjModel* m, const gsTable* t, const char* path);
+
+// Read the pose or states file at path and check it with gs_app_require_coordinates. Prints one
+// line and returns -1 otherwise.
+int gs_app_check_pose_file(const mjModel* m, const char* path);
+
 #endif  // GAITSIM_APP_GS_APP_MODEL_H_

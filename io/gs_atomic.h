@@ -1,4 +1,4 @@
-// gs_atomic.h: atomic file output and directory creation.
+// gs_atomic.h: atomic file and folder output, and directory creation.
 //
 // Every output file of gaitsim is written to a temporary file in the target's directory
 // (`path.tmp.XXXXXX`, created by mkstemp), flushed to disk (fflush + fsync) and renamed over the
@@ -22,6 +22,8 @@ typedef struct gsAtomicFile_ {
   FILE* f;        // stream to write to (the temporary file); NULL when not open
   char* path;     // final path (owned)
   char* tmppath;  // temporary path in the same directory, path.tmp.XXXXXX (owned)
+  void* sink;     // the stream's file descriptor and the errno of its first failed write, so
+                  // that a full disk is reported as ENOSPC, not as a bare stream error (owned)
 } gsAtomicFile;
 
 // Create the temporary file for `path`. The new file gets the mode of an existing target, else
@@ -43,5 +45,47 @@ int gs_atomic_write_buffer(const char* path, const void* bytes, size_t n, char* 
 // Succeeds when the directory already exists; fails when a component exists and is not a
 // directory.
 int gs_mkdir_p(const char* path, char* err, int errsz);
+
+// --- whole folders ------------------------------------------------------------------------------
+//
+// A result folder (a solution: states.sto, ..., summary.json) is written as a whole: into a
+// temporary folder beside it (`PARENT/.NAME.tmp.XXXXXX`, created by mkdtemp), which then replaces
+// the target in one step: rename() when the target does not exist, else an atomic exchange
+// (renameat2 RENAME_EXCHANGE; on a file system without it, two renames with a moment in between
+// where the target is absent) after which the old folder is removed. A reader sees the old
+// complete folder or the new complete one, never a mix, and a failed run leaves neither an empty
+// folder nor old and new files side by side. One transaction is open at a time per process.
+
+// A folder being written: write files into `staging`, then gs_folder_commit or gs_folder_abort.
+typedef struct gsFolderTx_ {
+  char* path;     // final folder (owned)
+  char* staging;  // temporary folder beside it, PARENT/.NAME.tmp.XXXXXX (owned); NULL: not open
+  char* made;     // the first parent folder this transaction created (removed on abort), or NULL
+} gsFolderTx;
+
+// May the folder at path be replaced by a new result? Yes when it does not exist, is empty, or
+// holds `marker` (e.g. "summary.json": an earlier result). Otherwise -1 with the reason (a file,
+// or a folder that is not a result: nothing of it is touched).
+int gs_folder_replaceable(const char* path, const char* marker, char* err, int errsz);
+
+// Create the temporary folder for path (and path's missing parents). On failure nothing is left
+// on disk and tx is zeroed.
+int gs_folder_begin(gsFolderTx* tx, const char* path, char* err, int errsz);
+
+// Sync the temporary folder and put it in place of path; the old folder, if any, is removed.
+// On failure the temporary folder is removed and path is as it was. Always releases tx.
+int gs_folder_commit(gsFolderTx* tx, char* err, int errsz);
+
+// Remove the temporary folder (and parents this transaction created); path is untouched. Safe
+// on a zeroed or released tx.
+void gs_folder_abort(gsFolderTx* tx);
+
+// From a signal handler: remove the files of the open transaction's temporary folder and the
+// folder, with async-signal-safe calls only (open, getdents64, unlinkat). Nothing when no
+// transaction is open.
+void gs_folder_abort_from_signal(void);
+
+// Remove path and everything below it (like rm -rf; symbolic links are removed, not followed).
+int gs_remove_tree(const char* path, char* err, int errsz);
 
 #endif  // GAITSIM_IO_GS_ATOMIC_H_

@@ -10,20 +10,92 @@
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
+#include <unistd.h>
 
 #include "optim/go_hessian.h"
 #include "optim/go_jacobian.h"
 
 void openblas_set_num_threads(int num_threads);  // OpenBLAS (cblas.h), declared here alone
 
-// set by SIGINT or go_ipopt_request_stop, cleared at the start of each solve (process-wide)
+// set by go_ipopt_request_stop, cleared at the start of each solve (process-wide)
 static volatile sig_atomic_t stop_requested = 0;
+// set by a stop signal, cleared by the solve that stops for it (process-wide)
+static volatile sig_atomic_t signal_pending = 0;
+// stop signals received: from the parent process, and from anyone else
+static volatile sig_atomic_t signals_from_parent = 0, signals_other = 0;
+static void (*volatile hard_stop_fn)(void) = NULL;
+static volatile sig_atomic_t stop_signals_installed = 0;
+#define GO_MAX_CHILDREN 8
+static volatile pid_t children[GO_MAX_CHILDREN];  // processes stop signals are passed on to
 
 void go_ipopt_request_stop(void) { stop_requested = 1; }
 
-static void on_sigint(int sig) {
-  (void)sig;
-  stop_requested = 1;
+int go_ipopt_stop_signals(void) {
+  return (int)(signals_from_parent > signals_other ? signals_from_parent : signals_other);
+}
+
+void go_ipopt_forward_signals_to(long pid, int add) {
+  for (int i = 0; i < GO_MAX_CHILDREN; i++) {
+    if (add ? children[i] == 0 : children[i] == (pid_t)pid) {
+      children[i] = add ? (pid_t)pid : 0;
+      return;
+    }
+  }
+}
+
+// SIGINT, SIGTERM, SIGHUP: the first asks for a stop, the second ends the process at once
+static void on_stop_signal(int sig, siginfo_t* info, void* ctx) {
+  (void)ctx;
+  int saved = errno;
+  int from_parent = info && info->si_code == SI_USER && info->si_pid == getppid();
+  int count = from_parent ? ++signals_from_parent : ++signals_other;
+  for (int i = 0; i < GO_MAX_CHILDREN; i++)
+    if (children[i] > 0) kill(children[i], sig);
+  if (count >= 2) {
+    if (hard_stop_fn) hard_stop_fn();
+    struct sigaction dfl;
+    memset(&dfl, 0, sizeof(dfl));
+    dfl.sa_handler = SIG_DFL;
+    sigemptyset(&dfl.sa_mask);
+    sigaction(sig, &dfl, NULL);
+    sigset_t unblock;
+    sigemptyset(&unblock);
+    sigaddset(&unblock, sig);
+    sigprocmask(SIG_UNBLOCK, &unblock, NULL);
+    raise(sig);
+    _exit(128 + sig);
+  }
+  if (count == 1) {
+    static const char msg[] = "gaitsim: stop signal: stopping at the next iteration and writing "
+                              "the best iterate (a second signal stops at once, writing nothing)\n";
+    ssize_t w = write(2, msg, sizeof(msg) - 1);
+    (void)w;
+  }
+  signal_pending = 1;
+  errno = saved;
+}
+
+static const int kStopSignals[3] = {SIGINT, SIGTERM, SIGHUP};
+
+// install on_stop_signal for the three signals; old (may be NULL) gets the previous actions
+static int install_handlers(struct sigaction old[3]) {
+  struct sigaction sa;
+  memset(&sa, 0, sizeof(sa));
+  sa.sa_sigaction = on_stop_signal;
+  sa.sa_flags = SA_SIGINFO;
+  sigemptyset(&sa.sa_mask);
+  for (int i = 0; i < 3; i++) sigaddset(&sa.sa_mask, kStopSignals[i]);
+  for (int i = 0; i < 3; i++)
+    if (sigaction(kStopSignals[i], &sa, old ? &old[i] : NULL) != 0) return -1;
+  return 0;
+}
+
+int go_ipopt_install_stop_signals(void (*hard_stop)(void)) {
+  hard_stop_fn = hard_stop;
+  if (stop_signals_installed) return 0;
+  if (install_handlers(NULL) != 0) return -1;
+  stop_signals_installed = 1;
+  return 0;
 }
 
 // --- options ------------------------------------------------------------------------------------
@@ -287,7 +359,8 @@ static Bool cb_iter(Index alg_mod, Index iter, Number obj, Number inf_pr, Number
             mu > 0 ? log10(mu) : -99.0, alpha_pr, t);
     fflush(s->opts->progress);
   }
-  if (stop_requested) {
+  if (stop_requested || signal_pending) {
+    signal_pending = 0;
     s->stop_reason = 1;
     return FALSE;
   }
@@ -455,14 +528,10 @@ int go_ipopt_solve(go_nlp* nlp, const go_ipopt_opts* opts, double* z, double* z_
   // variable at each ordering, and an explicit setting in the environment is left alone.
   setenv("SCOTCH_PTHREAD_NUMBER", "1", 0);
 
-  // Ctrl-C
-  struct sigaction old_sa, sa;
-  if (opts->handle_sigint) {
-    memset(&sa, 0, sizeof(sa));
-    sa.sa_handler = on_sigint;
-    sigemptyset(&sa.sa_mask);
-    sigaction(SIGINT, &sa, &old_sa);
-  }
+  // stop signals, for this solve unless installed for the process
+  struct sigaction old_sa[3];
+  int own_handlers = opts->handle_sigint && !stop_signals_installed;
+  if (own_handlers) install_handlers(old_sa);
   stop_requested = 0;
 
   double cpu0 = cpu_now();
@@ -472,7 +541,8 @@ int go_ipopt_solve(go_nlp* nlp, const go_ipopt_opts* opts, double* z, double* z_
                       mult ? mult->z_u : NULL, &s);
   res->wall_s = elapsed(&s.t0);
   res->cpu_s = cpu_now() - cpu0;
-  if (opts->handle_sigint) sigaction(SIGINT, &old_sa, NULL);
+  if (own_handlers)
+    for (int i = 0; i < 3; i++) sigaction(kStopSignals[i], &old_sa[i], NULL);
   FreeIpoptProblem(p);
 
   // the returned point: objective, violation, and a candidate for the best iterate

@@ -40,7 +40,8 @@ typedef struct {
   double best_viol_tol;   // violations at or below count as polishable: among them the best
                           // iterate is the lowest objective (scaled max violation, -)
   FILE* progress;         // one line per iteration; NULL: silent
-  int handle_sigint;      // 1: Ctrl-C stops the solve cleanly (handler restored afterwards)
+  int handle_sigint;      // 1: SIGINT, SIGTERM and SIGHUP stop the solve cleanly (handlers
+                          // restored afterwards; see go_ipopt_install_stop_signals)
   double fallback_rise;   // > 0: stop (GO_SOLVE_FELL_BACK) at the first iteration outside the
                           // restoration phase whose objective exceeds, by more than this
                           // fraction of its size, the lowest objective of the earlier iterations
@@ -65,7 +66,7 @@ typedef enum {
   GO_SOLVE_MAX_ITER,           // iteration limit
   GO_SOLVE_MAX_WALL_TIME,      // our wall-clock limit
   GO_SOLVE_MAX_CPU_TIME,       // Ipopt's max_cpu_time
-  GO_SOLVE_INTERRUPTED,        // SIGINT or go_ipopt_request_stop()
+  GO_SOLVE_INTERRUPTED,        // a stop signal (SIGINT, SIGTERM, SIGHUP) or go_ipopt_request_stop()
   GO_SOLVE_INFEASIBLE,         // locally infeasible
   GO_SOLVE_SMALL_STEP,         // search direction too small
   GO_SOLVE_DIVERGING,          // iterates diverging
@@ -126,5 +127,21 @@ const char* go_solve_status_str(go_solve_status status);
 
 // ask a running solve to stop at its next iteration (async-signal-safe)
 void go_ipopt_request_stop(void);
+
+// Stop signals for the rest of the process: SIGINT, SIGTERM and SIGHUP alike. The first one
+// asks the running solve, or the next one to start if none runs, to stop at its next iteration
+// (status GO_SOLVE_INTERRUPTED; later solves, e.g. a polish of the best iterate, run) and is
+// passed on to the registered child processes. A second one calls hard_stop (may be NULL; it
+// must be async-signal-safe, e.g. gs_folder_abort_from_signal), passes the signal on, and ends
+// the process by that signal at once. A signal sent by the parent process counts separately
+// from the others, so one Ctrl-C that reaches a process group and is also passed on by the
+// parent counts once. Idempotent; returns 0, or -1 when sigaction fails.
+int go_ipopt_install_stop_signals(void (*hard_stop)(void));
+
+// The number of stop signals received so far (0: none).
+int go_ipopt_stop_signals(void);
+
+// Register (pid > 0) or drop a child process that stop signals are passed on to (at most 8).
+void go_ipopt_forward_signals_to(long pid, int add);
 
 #endif  // GAITSIM_OPTIM_GO_IPOPT_H_

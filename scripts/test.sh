@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
-# The whole test suite: warnings-as-errors build + every test (ctest), the unit tests again under
-# AddressSanitizer/UndefinedBehaviorSanitizer, and the fuzz targets for a bounded time (clang).
+# The whole test suite: warnings-as-errors build + every test (ctest), the unit tests and a subset
+# of the command-line tests again under AddressSanitizer/UndefinedBehaviorSanitizer, and the fuzz
+# targets for a bounded time (clang; scripts/fuzz.sh runs them longer).
 #   scripts/test.sh            everything
 #   scripts/test.sh --quick    the warnings-as-errors build and its tests only
 set -euo pipefail
@@ -21,7 +22,15 @@ cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DGAITSIM_WERROR=ON -DGAITSIM_
 cmake --build build-asan -j"$jobs"
 (cd build-asan && ASAN_OPTIONS=detect_leaks=1 ctest --output-on-failure -j"$jobs" -L unit)
 
+# the command-line tests whose commands do not solve the full-body model (the catalogue of bad
+# input, signals and disk full among them): about 50 s; the others and the slow tests (full-body
+# and planar solves of minutes) take too long under the sanitizers' Debug build
+echo "== command-line tests under AddressSanitizer and UndefinedBehaviorSanitizer (a subset)"
+(cd build-asan && LSAN_OPTIONS=suppressions="$PWD/../tests/lsan.supp" ASAN_OPTIONS=detect_leaks=1 \
+  ctest --output-on-failure -j"$jobs" \
+  -R '^cli_(bad_inputs|model_errors|simulate_inspect|hold_drop|render|predict_goals)$')
+
 echo "== fuzz targets (clang, libFuzzer, bounded time)"
 CC=clang cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=Debug -DGAITSIM_FUZZ=ON >/dev/null
-cmake --build build-fuzz -j"$jobs" --target fuzz_storage
+cmake --build build-fuzz -j"$jobs" --target fuzz_storage fuzz_solution fuzz_options
 (cd build-fuzz && ctest --output-on-failure -L fuzz)

@@ -1,8 +1,11 @@
 # Fuzz targets (label "fuzz"), built only with -DGAITSIM_FUZZ=ON and clang:
 #   CC=clang cmake -S . -B build-fuzz -DGAITSIM_FUZZ=ON
-#   cmake --build build-fuzz --target fuzz_storage && ctest --test-dir build-fuzz -L fuzz
-# The io sources are compiled straight into the fuzzer so that all of it is instrumented
-# (the library gaitsim_core links MuJoCo, Ipopt and friends, which the fuzzer does not need).
+#   cmake --build build-fuzz --target fuzz_storage fuzz_solution fuzz_options
+#   ctest --test-dir build-fuzz -L fuzz          (30 s each; scripts/fuzz.sh SECONDS for longer)
+# fuzz_storage: the storage/CSV reader; its io sources are compiled straight into the fuzzer so
+# that all of it is instrumented. fuzz_solution (the solution-folder check of every reader) and
+# fuzz_options (the option readers, Ipopt option files) link gaitsim_core, which this
+# configuration instruments for coverage and the sanitizers.
 if(GAITSIM_FUZZ)
   if(NOT CMAKE_C_COMPILER_ID MATCHES "Clang")
     message(FATAL_ERROR "GAITSIM_FUZZ needs clang (libFuzzer): configure with CC=clang")
@@ -30,4 +33,22 @@ if(GAITSIM_FUZZ)
             -artifact_prefix=${GS_FUZZ_WORK}/artifacts/
             ${GS_FUZZ_WORK}/corpus ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/corpus_storage)
   set_tests_properties(fuzz_storage PROPERTIES LABELS fuzz TIMEOUT 120)
+
+  # readers inside the library: gaitsim_core instrumented (coverage for libFuzzer, ASan, UBSan)
+  target_compile_options(gaitsim_core PRIVATE -fsanitize=fuzzer-no-link,address,undefined
+                                              -fno-sanitize-recover=undefined -fno-omit-frame-pointer)
+  target_link_options(gaitsim_core INTERFACE -fsanitize=address,undefined)
+  foreach(target fuzz_solution fuzz_options)
+    add_executable(${target} ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/${target}.c)
+    target_link_libraries(${target} PRIVATE gaitsim_core)
+    target_compile_options(${target} PRIVATE ${GS_FUZZ_FLAGS})
+    target_link_options(${target} PRIVATE ${GS_FUZZ_FLAGS})
+    set(work ${CMAKE_CURRENT_BINARY_DIR}/${target}_work)
+    file(MAKE_DIRECTORY ${work}/corpus ${work}/artifacts)
+    add_test(NAME ${target}
+      COMMAND ${target} -max_total_time=30 -rss_limit_mb=2048 -timeout=10 -max_len=8192
+              -close_fd_mask=2 -print_final_stats=1 -artifact_prefix=${work}/artifacts/
+              ${work}/corpus ${CMAKE_CURRENT_SOURCE_DIR}/fuzz/corpus_${target})
+    set_tests_properties(${target} PROPERTIES LABELS fuzz TIMEOUT 120)
+  endforeach()
 endif()

@@ -1,5 +1,7 @@
 // test_render.c: the render module: a fixed pose against a stored golden image, solution
-// loading and its errors, cycles with forward translation, frame counts, PNG round trip.
+// loading and its errors, cycles with forward translation, frame counts, PNG round trip; and,
+// independent of the golden image, the joints of the drawn pose projected through the camera
+// (joint_positions_should_project_onto_the_body).
 //
 // Golden image: tests/fixtures/render_golden_160x120.png is the fixture solution
 // (tests/fixtures/solution_small) at 35 % of the cycle, 160x120, default (fast) quality, side
@@ -13,6 +15,7 @@
 // versions: edge pixels are a few percent of this picture, so a mean of 1.5 admits such
 // differences while a changed pose (checked below: 35 % vs 45 % of the cycle) or a missing
 // decoration (GRF arrows off) exceeds it.
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -84,26 +87,35 @@ static unsigned char* render_at(grRenderer* r, const grMotion* mo, double at) {
   return rgb;
 }
 
+// the model, the fixture motion and a renderer of w x h with o's other fields; 0 on success
+// (then free all three), else nothing is left to free
+static int open_fixture(int w, int h, grOptions* o, mjModel** m, grMotion* mo, grRenderer* r) {
+  char err[1024];
+  *m = gs_model_load(MODEL, err, sizeof(err));
+  EXPECT_TRUE(*m != NULL);
+  if (!*m) return -1;
+  EXPECT_EQ_INT(0, load_fixture(*m, mo));
+  o->width = w;
+  o->height = h;
+  if (gr_renderer_create(*m, o, r, err, sizeof(err)) != 0) {
+    fprintf(stderr, "renderer: %s\n", err);
+    EXPECT_TRUE(0);
+    gr_motion_free(mo);
+    mj_deleteModel(*m);
+    return -1;
+  }
+  return 0;
+}
+
 // the fixed pose against the golden image; a different pose and a missing arrow must fail it
 static void golden_image_should_match_within_tolerance(void) {
   char err[1024];
-  mjModel* m = gs_model_load(MODEL, err, sizeof(err));
-  EXPECT_TRUE(m != NULL);
-  if (!m) return;
+  mjModel* m;
   grMotion mo;
-  EXPECT_EQ_INT(0, load_fixture(m, &mo));
   grOptions o;
-  gr_options_default(&o);
-  o.width = 160;
-  o.height = 120;
   grRenderer r;
-  if (gr_renderer_create(m, &o, &r, err, sizeof(err)) != 0) {
-    fprintf(stderr, "renderer: %s\n", err);
-    EXPECT_TRUE(0);
-    gr_motion_free(&mo);
-    mj_deleteModel(m);
-    return;
-  }
+  gr_options_default(&o);
+  if (open_fixture(160, 120, &o, &m, &mo, &r) != 0) return;
   unsigned char* img = render_at(&r, &mo, 0.35);  // first frame: the command's call sequence
   EXPECT_TRUE(img != NULL);
   if (getenv("GAITSIM_UPDATE_GOLDEN")) {
@@ -285,9 +297,101 @@ static void png_should_round_trip(void) {
   EXPECT_EQ_INT(-1, gr_png_write("/nonexistent/dir/x.png", img, 7, 5, err, sizeof(err)));
 }
 
+// pixel (u right, v down) of world point p through the renderer's free camera, MuJoCo's
+// convention (mjv_updateCamera): forward f = (cos e cos a, cos e sin a, sin e), up
+// (-sin e cos a, -sin e sin a, cos e), eye at lookat - distance f, vertical field of view fovy
+// (deg), square pixels; 0 when p is behind the camera
+static int project(const grRenderer* r, const double* p, double* u, double* v) {
+  double a = r->cam.azimuth * mjPI / 180, e = r->cam.elevation * mjPI / 180;
+  double f[3] = {cos(e) * cos(a), cos(e) * sin(a), sin(e)};
+  double up[3] = {-sin(e) * cos(a), -sin(e) * sin(a), cos(e)};
+  double right[3] = {f[1] * up[2] - f[2] * up[1], f[2] * up[0] - f[0] * up[2],
+                     f[0] * up[1] - f[1] * up[0]};
+  double rel[3];
+  for (int i = 0; i < 3; i++) rel[i] = p[i] - (r->cam.lookat[i] - r->cam.distance * f[i]);
+  double z = rel[0] * f[0] + rel[1] * f[1] + rel[2] * f[2];
+  if (z <= 0) return 0;
+  double x = rel[0] * right[0] + rel[1] * right[1] + rel[2] * right[2];
+  double y = rel[0] * up[0] + rel[1] * up[1] + rel[2] * up[2];
+  double t = tan(r->m->vis.global.fovy * mjPI / 360), w = r->o.width, h = r->o.height;
+  *u = 0.5 * w * (1 + x / (z * t * w / h));
+  *v = 0.5 * h * (1 - y / (z * t));
+  return 1;
+}
+
+// 1 when a body pixel (mask) lies within `radius` pixels of (u, v)
+static int near_mask(const unsigned char* mask, int w, int h, double u, double v, int radius) {
+  for (int dv = -radius; dv <= radius; dv++)
+    for (int du = -radius; du <= radius; du++) {
+      int x = (int)floor(u) + du, y = (int)floor(v) + dv;
+      if (x >= 0 && y >= 0 && x < w && y < h && mask[y * w + x]) return 1;
+    }
+  return 0;
+}
+
+// An independent check of the picture (the golden image is the program's own output): every
+// hinge joint's anchor in the drawn pose (d->xanchor after mj_kinematics), projected through the
+// camera by project() above, lies within 2 pixels of a pixel the body covers: one that differs
+// (by more than 24 of 255 in a channel) from the same frame drawn with the body's geoms and
+// tendons hidden. Moved 0.4 m forward (world +x) the anchors land on the body at most a third
+// of the time, so a wrong camera, pose or projection fails it.
+static void joint_positions_should_project_onto_the_body(void) {
+  mjModel* m;
+  grMotion mo;
+  grOptions o;
+  grRenderer r;
+  gr_options_default(&o);
+  o.overlay = 0;
+  o.grf_scale = 0;
+  o.knee_scale = 0;
+  if (open_fixture(320, 240, &o, &m, &mo, &r) != 0) return;
+  unsigned char* img = render_at(&r, &mo, 0.35);
+  mj_kinematics(m, r.d);
+  int nj = 0, on = 0, on_moved = 0, inside = 0;
+  double* uv = (double*)calloc(4 * (size_t)m->njnt, sizeof(double));
+  for (int j = 0; j < m->njnt; j++) {
+    if (m->jnt_type[j] != mjJNT_HINGE) continue;
+    const double* p = r.d->xanchor + 3 * j;
+    double moved[3] = {p[0] + 0.4, p[1], p[2]};
+    int ok = project(&r, p, &uv[4 * nj], &uv[4 * nj + 1]) &&
+             project(&r, moved, &uv[4 * nj + 2], &uv[4 * nj + 3]);
+    inside += ok && uv[4 * nj] >= 0 && uv[4 * nj] < o.width && uv[4 * nj + 1] >= 0 &&
+              uv[4 * nj + 1] < o.height;
+    nj++;
+  }
+  // the same frame without the body: its geoms to group 5 (hidden), no tendons
+  for (int g = 0; g < m->ngeom; g++)
+    if (m->geom_bodyid[g] > 0) m->geom_group[g] = 5;
+  r.opt.geomgroup[5] = 0;
+  for (int k = 0; k < mjNGROUP; k++) r.opt.tendongroup[k] = 0;
+  unsigned char* bare = render_at(&r, &mo, 0.35);
+  unsigned char* mask = (unsigned char*)calloc((size_t)o.width * o.height, 1);
+  long body_pixels = 0;
+  for (int i = 0; img && bare && mask && i < o.width * o.height; i++) {
+    for (int c = 0; c < 3; c++) mask[i] |= abs(img[3 * i + c] - bare[3 * i + c]) > 24;
+    body_pixels += mask[i];
+  }
+  for (int j = 0; mask && j < nj; j++) {
+    on += near_mask(mask, o.width, o.height, uv[4 * j], uv[4 * j + 1], 2);
+    on_moved += near_mask(mask, o.width, o.height, uv[4 * j + 2], uv[4 * j + 3], 2);
+  }
+  printf("projected joints: %d hinges, %d in the frame, %d on the body (%ld body pixels); moved "
+         "0.4 m forward: %d on the body\n", nj, inside, on, body_pixels, on_moved);
+  EXPECT_TRUE(nj >= 15);
+  EXPECT_EQ_INT(nj, inside);
+  EXPECT_EQ_INT(nj, on);
+  EXPECT_TRUE(3 * on_moved <= nj);
+  EXPECT_TRUE(body_pixels > 500);
+  free(uv), free(img), free(bare), free(mask);
+  gr_renderer_free(&r);
+  gr_motion_free(&mo);
+  mj_deleteModel(m);
+}
+
 int main(void) {
   gs_mujoco_install_handlers();
   golden_image_should_match_within_tolerance();  // first: the command's call sequence
+  joint_positions_should_project_onto_the_body();
   fixture_should_load_and_repeat_with_forward_translation();
   bad_solution_folders_should_name_the_file();
   png_should_round_trip();

@@ -5,7 +5,7 @@
 # polish does not reach feasibility), every file is written (metabolics.sto: the muscles and
 # their total; knee_contact.sto: both knees) and summary.json carries the prediction figures and
 # the peak knee contact of both knees; bad usage exits 2, a missing guess exits 1
-# with one line naming the file.
+# with one line naming the folder.
 # usage: predict.sh GAITSIM SOURCE_DIR
 set -u
 gaitsim=$1 src=$2
@@ -80,5 +80,6 @@ check "no --guess: usage, exit 2" test $? -eq 2
 err=$("$gaitsim" predict --guess nowhere --speed 0.8 --out x 2>&1 >/dev/null)
 status=$?
 check "missing guess exits 1 (got $status)" test "$status" -eq 1
-check "one line naming the file" test "$(grep -c 'nowhere/states.sto' <<<"$err")" -eq 1
+check "one line naming the folder: $err" test "$(grep -c '^gaitsim: nowhere: ' <<<"$err")" -eq 1 -a \
+  "$(wc -l <<<"$err")" -eq 1
 finish

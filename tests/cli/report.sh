@@ -92,7 +92,7 @@ cp -r sol nan && rm -rf nan/report
 awk 'f && n++ == 3 {$39 = "nan"} {print} /^endheader/ {f = 1}' OFS='\t' sol/controls.sto >nan/controls.sto
 err=$("$gaitsim" report nan 2>&1 >/dev/null)
 check "NaN exits 1" test $? -eq 1
-check "NaN: one line naming controls.sto (got: $err)" test "$(wc -l <<<"$err")" -eq 1 -a -n "$(grep '^gaitsim: .*controls\.sto: column .*NaN' <<<"$err")"
+check "NaN: one line naming controls.sto (got: $err)" test "$(wc -l <<<"$err")" -eq 1 -a -n "$(grep '^gaitsim: .*controls\.sto:.*column .*NaN' <<<"$err")"
 check "NaN: nothing written" test ! -e nan/report
 
 # usage

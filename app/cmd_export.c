@@ -48,10 +48,8 @@ int gs_cmd_export(int argc, char** argv) {
 
   // the model the solution was solved with, unless told otherwise
   char solved_with[4096];
-  const char* mpath = model_path ? model_path
-                      : gs_app_solution_model(dir, solved_with, (int)sizeof(solved_with))
-                          ? solved_with
-                          : GS_DEFAULT_MODEL;
+  const char* mpath =
+      gs_app_model_for_solution(dir, model_path, solved_with, (int)sizeof(solved_with));
   char err[1024];
   mjModel* m = gs_model_load(mpath, err, sizeof(err));
   if (!m) {

@@ -88,3 +88,8 @@ const char* gs_app_solution_model(const char* dir, char* buf, int n) {
   cJSON_Delete(j);
   return found;
 }
+
+const char* gs_app_model_for_solution(const char* dir, const char* given, char* buf, int n) {
+  if (given) return given;
+  return gs_app_solution_model(dir, buf, n) ? buf : GS_DEFAULT_MODEL;
+}

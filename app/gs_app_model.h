@@ -33,4 +33,8 @@ struct cJSON* gs_app_read_json(const char* path);
 // file is gone).
 const char* gs_app_solution_model(const char* dir, char* buf, int n);
 
+// The model to use on solution folder dir: `given` (a --model option) when not NULL, else the
+// model dir/summary.json names (copied into buf, size n), else GS_DEFAULT_MODEL.
+const char* gs_app_model_for_solution(const char* dir, const char* given, char* buf, int n);
+
 #endif  // GAITSIM_APP_GS_APP_MODEL_H_

@@ -15,9 +15,12 @@
 //   gs_lib_equilibrate(m, d);                              // elastic tendons at rest
 //   for (...) { ... set ctrl ...; gs_lib_step(m, d); }
 //
-// Ownership: the library allocates nothing the caller must free. mjModel and mjData stay the
-// caller's (mj_deleteModel, mj_deleteData). gs_lib_prepare changes the model in place and keeps
-// no pointer to it; messages are written into the caller's buffers.
+// Ownership: the library returns nothing the caller must free. mjModel and mjData stay the
+// caller's (mj_deleteModel, mj_deleteData, at any time after the last call that uses them).
+// gs_lib_prepare changes the model in place; for an implant-knee model it also caches the knee's
+// numbers inside the library, keyed by the model's address and re-checked against the model's
+// contents on use, and keeps that small cache until the process ends. Messages are written into
+// the caller's buffers.
 //
 // Threads: the callbacks are process-global MuJoCo pointers (mjcb_act_dyn, mjcb_act_gain,
 // mjcb_act_bias, mjcb_passive): gs_lib_install sets them for every model in the process, so a

@@ -97,7 +97,9 @@ static void write_mjcf(FILE* f, const mjModel* m, const char* include, const cha
                        const gsTable* t, const gsStateMap* map, double* qpos, double* qvel,
                        double* act) {
   fputs("<!-- gaitsim export: the solved gait of ", f);
-  for (const char* s = states_path; *s; s++) fputc(*s == '-' ? '_' : *s, f);  // no "--"
+  for (const char* s = states_path; *s; s++) {
+    fputc(*s == '-' && s > states_path && s[-1] == '-' ? '_' : *s, f);  // "--" ends a comment
+  }
   fputs(" as keyframes gait_000... (time s, qpos rad/m, qvel rad/s or m/s, act -). -->\n", f);
   fputs("<mujoco model=\"gaitsim export\">\n  <include file=\"", f);
   put_xml_attr(f, include);
@@ -173,6 +175,12 @@ int gr_keyframes_export(const mjModel* m, const char* model_path, const char* st
   if (gs_mkdir_p(dir, err, errsz) != 0) goto done;
   if (gr_keyframes_relative_path(model_path, dir, info->include, (int)sizeof(info->include), err,
                                  errsz) != 0) {
+    goto done;
+  }
+  char real_out[PATH_MAX], real_model[PATH_MAX];
+  if (realpath(out_path, real_out) && realpath(model_path, real_model) &&
+      strcmp(real_out, real_model) == 0) {
+    gs_error_set(err, errsz, "%s: is the model itself; give another --out", out_path);
     goto done;
   }
 

@@ -3,7 +3,7 @@
 // its states.sto row: time to 1e-12 s, qpos to 1e-12 rad or m (degrees converted here, by joint
 // type, not by the exporter's code), speeds and activations likewise or 0 where states.sto has
 // none. Also: include paths relative to the exported file's folder; a model coordinate missing
-// from states.sto fails and leaves no file.
+// from states.sto fails and leaves no file; --out naming the model itself fails, model intact.
 //
 //   test_keyframes                        export tests/fixtures/solution_small and check it
 //   test_keyframes EXPORT.xml STATES.sto  check an existing export (the CLI test's `gaitsim export`)
@@ -161,6 +161,22 @@ static void missing_coordinate_should_fail_without_a_file(const char* dir) {
   mj_deleteModel(m);
 }
 
+static void model_should_not_be_overwritten(const char* dir) {
+  char model[4096], err[1024], merr[1024], cmd[8400];
+  snprintf(model, sizeof(model), "%s/copy.xml", dir);
+  snprintf(cmd, sizeof(cmd), "cp '%s' '%s'", MODEL, model);
+  EXPECT_EQ_INT(0, system(cmd));
+  mjModel* m = mj_loadXML(model, NULL, merr, sizeof(merr));
+  EXPECT_TRUE(m != NULL);
+  if (!m) return;
+  EXPECT_EQ_INT(-1, gr_keyframes_export(m, model, FIXTURE, model, NULL, err, sizeof(err)));
+  EXPECT_TRUE(strstr(err, "is the model itself") != NULL);
+  mj_deleteModel(m);
+  m = mj_loadXML(model, NULL, merr, sizeof(merr));  // still the model
+  EXPECT_TRUE(m != NULL && m->nq == 26);
+  if (m) mj_deleteModel(m);
+}
+
 int main(int argc, char** argv) {
   if (argc == 3) {
     EXPECT_TRUE(check_export(argv[1], argv[2]) > 0);
@@ -176,6 +192,7 @@ int main(int argc, char** argv) {
   relative_paths_should_start_from_the_output_folder(dir);
   fixture_should_export_and_load_in_stock_mujoco(dir);
   missing_coordinate_should_fail_without_a_file(dir);
+  model_should_not_be_overwritten(dir);
   char cmd[4200];
   snprintf(cmd, sizeof(cmd), "rm -rf '%s'", dir);
   if (system(cmd) != 0) fprintf(stderr, "could not remove %s\n", dir);

@@ -50,8 +50,8 @@ int gr_keyframes_relative_path(const char* target, const char* from_dir, char* o
 // Creates out_path's folder when missing. The file is written atomically (io/gs_atomic.h) and,
 // before it replaces anything, compiled by stock MuJoCo (mj_loadXML, no gaitsim callbacks) and
 // checked to hold the model's degrees of freedom and nkey + rows keys; a file that would not
-// load is never published. Every hinge/slide coordinate of m must have a column. info may be
-// NULL.
+// load is never published. Every hinge/slide coordinate of m must have a column; an out_path
+// that is the model file itself is refused. info may be NULL.
 int gr_keyframes_export(const mjModel* m, const char* model_path, const char* states_path,
                         const char* out_path, grKeyframesInfo* info, char* err, int errsz);
 

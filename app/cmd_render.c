@@ -174,10 +174,8 @@ int gs_cmd_render(int argc, char** argv) {
   // a solution folder is drawn with the model it was solved with (its summary.json)
   char solved_with[4096];
   const char* mpath = bare_model ? input
-                      : model_path ? model_path
-                      : gs_app_solution_model(input, solved_with, (int)sizeof(solved_with))
-                          ? solved_with
-                          : GS_DEFAULT_MODEL;
+                                  : gs_app_model_for_solution(input, model_path, solved_with,
+                                                              (int)sizeof(solved_with));
   char err[1024], states[4200];
   if (!bare_model && gs_app_check_solution(input, 0) != 0) return GS_EXIT_FAILURE;
   mjModel* m = gs_model_load(mpath, err, sizeof(err));

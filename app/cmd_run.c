@@ -37,9 +37,9 @@ static const char* kRunUsage =
     "stopped short (its best iterate written), else as the failing step.\n\n"
     "  --max-iter N   Ipopt iteration limit of each predictive solve (default 1500: an iteration\n"
     "                 budget, not a time limit, so that the results do not depend on the load\n"
-    "                 of the machine; in the main jobs of 2026-12-02 they reached Ipopt's\n"
-    "                 acceptable level after 419-865 (0.8 m/s) and 481-860 (2.0 m/s)\n"
-    "                 iterations, 6-13 minutes, on 2 cores)\n"
+    "                 of the machine; in the measured main jobs (docs/BENCHMARKS.md) they\n"
+    "                 reached Ipopt's acceptable level after 419-865 (0.8 m/s) and 481-860\n"
+    "                 (2.0 m/s) iterations, 6-13 minutes, on 2 cores)\n"
     "  --max-time S   wall-clock limit of each predictive solve, s (default none); the tracking\n"
     "                 solve stops after 600 iterations (1000 on a continued mesh)\n";
 

@@ -227,3 +227,8 @@ int gs_app_check_pose_file(const mjModel* m, const char* path) {
   gs_table_free(&t);
   return rc;
 }
+
+const char* gs_app_model_for_solution(const char* dir, const char* given, char* buf, int n) {
+  if (given) return given;
+  return gs_app_solution_model(dir, buf, n) ? buf : GS_DEFAULT_MODEL;
+}

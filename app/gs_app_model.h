@@ -48,5 +48,8 @@ int gs_app_require_coordinates(const mjModel* m, const gsTable* t, const char* p
 // Read the pose or states file at path and check it with gs_app_require_coordinates. Prints one
 // line and returns -1 otherwise.
 int gs_app_check_pose_file(const mjModel* m, const char* path);
+// The model to use on solution folder dir: `given` (a --model option) when not NULL, else the
+// model dir/summary.json names (copied into buf, size n), else GS_DEFAULT_MODEL.
+const char* gs_app_model_for_solution(const char* dir, const char* given, char* buf, int n);
 
 #endif  // GAITSIM_APP_GS_APP_MODEL_H_

@@ -12,6 +12,7 @@ const gsCommand gs_commands[] = {
     {"predict", gs_cmd_predict, "predictive solve at a new speed: minimum cost of transport, free stride time"},
     {"sweep", gs_cmd_sweep, "predictive solves over a range of speeds by continuation"},
     {"render", gs_cmd_render, "headless gait video, picture or filmstrip of a solution (OSMesa)"},
+    {"export", gs_cmd_export, "a solution as MuJoCo keyframes in an MJCF that includes the model"},
     {"report", gs_cmd_report, "figures and a table of a solution vs the measured trial (matplotlib)"},
     {NULL, NULL, NULL},
 };

@@ -21,6 +21,7 @@ int gs_cmd_sweep(int argc, char** argv);
 int gs_cmd_inspect(int argc, char** argv);
 int gs_cmd_render(int argc, char** argv);
 int gs_cmd_report(int argc, char** argv);
+int gs_cmd_export(int argc, char** argv);
 
 // The table of subcommands, terminated by an entry with name NULL.
 extern const gsCommand gs_commands[];

@@ -12,6 +12,7 @@ PACKAGES=(
   coinor-libipopt-dev libopenblas-dev
   libosmesa6-dev libgl-dev libpng-dev libcjson-dev
   ffmpeg
+  xvfb x11-apps xdotool
   python3 python3-numpy python3-scipy python3-matplotlib
 )
 

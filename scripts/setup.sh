@@ -13,6 +13,7 @@ PACKAGES=(
   libosmesa6-dev libgl-dev libpng-dev libcjson-dev
   ffmpeg
   python3 python3-numpy python3-scipy python3-matplotlib
+  munge slurm-wlm
 )
 
 missing=()

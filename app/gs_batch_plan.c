@@ -270,7 +270,7 @@ int gs_batch_plan_find(const gsBatchPlan* plan, const char* name) {
 
 // the expanded solves that a plan name stands for: [first, first + count); count 0 when unknown
 static int lookup(const gsBatchPlan* p, const cJSON* solves, const char* name, int* first) {
-  int k = 0, j = 0;
+  int k = 0;
   const cJSON* s;
   cJSON_ArrayForEach(s, solves) {
     const cJSON* sw = cJSON_GetObjectItemCaseSensitive(s, "sweep");
@@ -280,7 +280,7 @@ static int lookup(const gsBatchPlan* p, const cJSON* solves, const char* name, i
       *first = k;
       return n;
     }
-    k += n, j++;
+    k += n;
   }
   int i = gs_batch_plan_find(p, name);  // one speed of a sweep, NAME_V
   *first = i;

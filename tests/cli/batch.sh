@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# gaitsim batch --local on the planar model (mjmodels/gait2d.xml, 10 nodes; about 40 s on 2
+# gaitsim batch --local on the planar model (mjmodels/gait2d.xml, 5 nodes; about 30 s on 2
 # cores): a plan of two tracks (10 iterations), a three-speed sweep from the first (each speed
 # from the one before, 3 iterations each), a track made to fail (a broken model) and a prediction
 # from it. With --local 2: the two tracks run at once and never more than two solves; exit 1
@@ -22,7 +22,7 @@ echo '<mujoco><worldbody><body><joint type="bogus"/></body></worldbody></mujoco>
 plan() {  # plan SWEEP_ITER: the test plan into plan.json
   cat >plan.json <<EOF
 {"model": "$src/mjmodels/gait2d.xml",
- "options": {"nodes": 10, "threads": 1, "max-iter": 10, "refine": 0},
+ "options": {"nodes": 5, "threads": 1, "max-iter": 10, "refine": 0},
  "solves": [
   {"name": "t1", "track": "$trial"},
   {"name": "t2", "track": "$trial", "options": {"weight": ["grf=5"]}},
@@ -174,6 +174,23 @@ bad_plan "option of the other command" 'solves[0].options.refine: not an option 
   "{\"name\": \"a\", \"predict\": 1.2, \"guess\": \"$PWD/out/t1\", \"options\": {\"refine\": 2}}"
 bad_plan "unknown trial" 'solves[0].track: no trial folder (coordinates.mot, grf.mot) "nowhere"' \
   '{"name": "a", "track": "nowhere"}'
+# the plan's option table follows the commands: every option in `gaitsim track --help` and
+# `gaitsim predict --help` is known to the plan (a wrong value is refused as a value)
+known=0 unknown=""
+for cmd in track predict; do
+  if [ "$cmd" = track ]; then head="\"track\": \"$trial\""; else head="\"predict\": 1.2, \"guess\": \"$PWD/out/t1\""; fi
+  for opt in $("$gaitsim" "$cmd" --help | grep -oE '^ +--[a-z-]+' | sed 's/^ *--//'); do
+    echo "{\"solves\": [{\"name\": \"a\", $head, \"options\": {\"$opt\": {}}}]}" >p.json
+    err=$("$gaitsim" batch p.json --check 2>&1 >/dev/null)
+    case $err in
+      *"options.$opt: "*unknown*|*"options.$opt: not an option"*|"") unknown="$unknown $cmd:$opt" ;;
+      *"options.$opt: "*) known=$((known + 1)) ;;
+      *) unknown="$unknown $cmd:$opt($err)" ;;
+    esac
+  done
+done
+check "every option of track and predict known to the plan (unknown:$unknown)" test -z "$unknown"
+check "options checked: at least 25 (got $known)" test "$known" -ge 25
 "$gaitsim" batch plan.json --out x --local 0 >/dev/null 2>&1
 check "--local 0: usage, exit 2" test $? -eq 2
 finish

@@ -2,7 +2,7 @@
 # gaitsim batch --slurm against a real one-node Slurm cluster started here on localhost from
 # Debian's packages (munge, slurm-wlm: slurmctld, slurmd; scripts/setup.sh installs them), in a
 # temporary folder with its own munge key and socket, state and spool folders and two free ports,
-# no cgroups (proctrack/linuxproc, task/none). It submits a plan on the planar model (about 90 s
+# no cgroups (proctrack/linuxproc, task/none). It submits a plan on the planar model (about 30 s
 # on 2 cores): two tracks, a three-speed sweep from the first, a track made to fail (a broken
 # model) and a prediction from it. Expected: the three independent solves in one job array, the
 # others single jobs with afterok dependencies; batch-status --wait ends with the tracks and the
@@ -108,7 +108,7 @@ trial=$src/mjmodels/trials/jw_ngait_og5
 echo '<mujoco><worldbody><body><joint type="bogus"/></body></worldbody></mujoco>' >bad.xml
 cat >plan.json <<EOF
 {"model": "$src/mjmodels/gait2d.xml",
- "options": {"nodes": 10, "threads": 1, "max-iter": 10, "refine": 0},
+ "options": {"nodes": 5, "threads": 1, "max-iter": 10, "refine": 0},
  "slurm": {"time_min": 10},
  "solves": [
   {"name": "t1", "track": "$trial"},

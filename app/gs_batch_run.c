@@ -128,7 +128,8 @@ static void write_record(const gsBatchPlan* plan, int i, const char* dir, const 
 }
 
 // start solve i: its folder (its old record removed), log.txt, the child in its own process
-// group (so that a terminal's Ctrl-C reaches it only through the batch); its pid, or -1 and err
+// group (so that a terminal's Ctrl-C reaches it only through the batch) ignoring SIGTERM; its
+// pid, or -1 and err
 static pid_t start(const gsBatchPlan* plan, int i, const char* dir, const char* exe, char* err,
                    int errsz) {
   char path[2 * GS_BATCH_PATH_MAX + 16];
@@ -153,8 +154,11 @@ static pid_t start(const gsBatchPlan* plan, int i, const char* dir, const char* 
     dup2(fd, 1);
     dup2(fd, 2);
     close(fd);
+    // SIGINT stops the solve with its best iterate; SIGTERM is ignored (kept across exec), as
+    // the batch turns its own SIGTERM into a SIGINT: Slurm's scancel and time limit signal every
+    // process of a job, and the solve must not die before it has written its result
     signal(SIGINT, SIG_DFL);
-    signal(SIGTERM, SIG_DFL);
+    signal(SIGTERM, SIG_IGN);
     execv(exe, argv);
     fprintf(stderr, "gaitsim: %s: %s\n", exe, strerror(errno));
     _exit(127);

@@ -164,6 +164,23 @@ int gs_batch_slurm_submit(const gsBatchPlan* plan, const char* dir, const char* 
     gs_error_set(err, errsz, "out of memory");
     goto done;
   }
+  // solves of an earlier submission still queued or running: no second job for them
+  const char** state = (const char**)calloc((size_t)n, sizeof(char*));
+  int live = state ? gs_batch_slurm_status(plan, dir, state, err, errsz) : -1;
+  if (live != 0) {
+    if (live > 0) {
+      char list[512] = "";
+      for (int i = 0; i < n; i++)
+        if (!strcmp(state[i], "pending") || !strcmp(state[i], "running"))
+          snprintf(list + strlen(list), sizeof(list) - strlen(list), "%s%s", list[0] ? ", " : "",
+                   plan->solve[i].name);
+      gs_error_set(err, errsz, "%d solves of an earlier submission are still queued or running "
+                   "(%s): wait for them (gaitsim batch-status --wait) or scancel them", live, list);
+    }
+    free(state);
+    goto done;
+  }
+  free(state);
   gs_batch_complete(plan, dir, complete);
   int kept = 0;
   for (int i = 0; i < n; i++) {

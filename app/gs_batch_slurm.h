@@ -13,8 +13,9 @@
 #include "app/gs_batch_plan.h"
 
 // Submit the plan's incomplete solves (DIR absolute, exe the absolute gaitsim path). Prints one
-// line per job on stdout. 0, or -1 and err (sbatch missing or refusing: what was submitted before
-// stays submitted and is in jobs.json).
+// line per job on stdout. 0, or -1 and err: solves of an earlier submission still pending or
+// running (nothing submitted), or sbatch missing or refusing (what was submitted before stays
+// submitted and is in jobs.json).
 int gs_batch_slurm_submit(const gsBatchPlan* plan, const char* dir, const char* exe, char* err,
                           int errsz);
 

@@ -9,7 +9,9 @@
 # sweep stopped short at their limits (exit 3), the failure failed and its dependant skipped
 # (cancelled by Slurm, never run) while the independent ones went on; batch.csv agrees. The same
 # plan submitted again submits only the failure and its dependant (the five that ended are kept,
-# their records untouched). Every daemon it started is stopped at the end.
+# their records untouched). A long solve: submitting it again while it is queued is refused, and
+# scancel stops it with its best iterate written (status interrupted). Every daemon it started is
+# stopped at the end.
 # When Slurm is not installed or cannot start here, the test says so on stderr, leaves
 # BUILD_DIR/slurm_skipped.txt with the reason (scripts/test.sh prints it) and exits 77 (CTest:
 # skipped). Label: slurm.
@@ -168,6 +170,33 @@ check "again: five kept, two submitted" grep -q '^batch: 7 solves, 5 kept from a
 timeout 120 "$gaitsim" batch-status "$out" --wait >status2.txt 2>&1
 check "again: the same statuses" cmp -s status1.txt status2.txt
 check "again: t1 not redone" cmp -s t1_record.json "$out/t1/batch.json"
+
+# a long solve: a second submission while it is queued is refused; scancel (SIGTERM to every
+# process of the job) stops it with its best iterate written
+cat >long.json <<EOF
+{"model": "$src/mjmodels/gait2d.xml",
+ "solves": [{"name": "long", "track": "$trial",
+             "options": {"nodes": 10, "threads": 1, "max-iter": 5000, "refine": 0}}]}
+EOF
+"$gaitsim" batch long.json --out "$work/lo" --slurm >submit3.txt 2>&1
+check "long: submitted" test $? -eq 0
+err=$("$gaitsim" batch long.json --out "$work/lo" --slurm 2>&1 >/dev/null)
+status=$?
+check "long: a second submission while queued: exit 1 (got $status)" test "$status" -eq 1
+check "long: one line naming the queued solve" grep -q '^gaitsim: long.json: 1 solves of an earlier submission are still queued or running (long)' <<<"$err"
+for _ in $(seq 600); do grep -q '^iter' "$work/lo/long/log.txt" 2>/dev/null && break; sleep 0.1; done
+scancel "$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["long"])' "$work/lo/slurm/jobs.json")"
+timeout 120 "$gaitsim" batch-status "$work/lo" --wait >status3.txt 2>&1
+check "long: scancel: interrupted" test "$(awk '{print $2}' status3.txt)" = interrupted
+check "long: scancel: the best iterate written" /usr/bin/python3 - "$work/lo/long" <<'PY'
+import json, sys
+r = json.load(open(sys.argv[1] + "/batch.json"))
+s = json.load(open(sys.argv[1] + "/summary.json"))
+ok = r["interrupted"] and r["exit"] == 3 and s["iterations"] < 5000
+if not ok:
+    print(r, s.get("iterations"), file=sys.stderr)
+sys.exit(0 if ok else 1)
+PY
 
 stop_daemons
 gone() { local p; for p in "${pids[@]}"; do if kill -0 "$p" 2>/dev/null; then return 1; fi; done; }

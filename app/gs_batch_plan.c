@@ -440,7 +440,7 @@ static int fill_solve(gsBatchPlan* p, const cJSON* root, const cJSON* e, int idx
   // nodes, docs/BENCHMARKS.md, with a margin), at least 10 min; memory 1 GB plus 20 MB per node
   s->cpus = arg_int(s, "--threads", 2);
   int nodes = arg_int(s, "--nodes", s->kind == GS_BATCH_TRACK ? 80 : 20);
-  int iter = arg_int(s, "--max-iter", s->kind == GS_BATCH_TRACK ? 1000 : 1000);
+  int iter = arg_int(s, "--max-iter", 1000);  // both commands' default
   s->time_min = 10 + (int)(0.05 * nodes * iter / 60);
   s->mem_mb = 1024 + 20 * nodes;
   if (slurm_resources(cJSON_GetObjectItemCaseSensitive(root, "slurm"), s, "slurm", err, errsz))

@@ -438,6 +438,8 @@ static int fill_solve(gsBatchPlan* p, const cJSON* root, const cJSON* e, int idx
   // Slurm: CPUs from --threads (the commands' default 2); time from the iterations and nodes at
   // 0.05 s per node and iteration (the full-body tracking solve's 1.0 s per iteration at 80
   // nodes, docs/BENCHMARKS.md, with a margin), at least 10 min; memory 1 GB plus 20 MB per node
+  // (measured peak of the full-body track with L-BFGS: 120 MB at 20 nodes, 238 MB at 80; the
+  // exact-Hessian refinement's factorisation needs more, a margin left for it, not measured)
   s->cpus = arg_int(s, "--threads", 2);
   int nodes = arg_int(s, "--nodes", s->kind == GS_BATCH_TRACK ? 80 : 20);
   int iter = arg_int(s, "--max-iter", 1000);  // both commands' default

@@ -11,6 +11,8 @@ const gsCommand gs_commands[] = {
     {"track", gs_cmd_track, "tracking solve of one stride by direct collocation"},
     {"predict", gs_cmd_predict, "predictive solve at a new speed: minimum cost of transport, free stride time"},
     {"sweep", gs_cmd_sweep, "predictive solves over a range of speeds by continuation"},
+    {"batch", gs_cmd_batch, "many solves from a plan, here (--local N) or on Slurm (--slurm)"},
+    {"batch-status", gs_cmd_batch_status, "done / running / pending / failed per solve of a batch"},
     {"render", gs_cmd_render, "headless gait video, picture or filmstrip of a solution (OSMesa)"},
     {"export", gs_cmd_export, "a solution as MuJoCo keyframes in an MJCF that includes the model"},
     {"report", gs_cmd_report, "figures and a table of a solution vs the measured trial (matplotlib)"},

@@ -14,6 +14,7 @@ PACKAGES=(
   ffmpeg
   xvfb x11-apps xdotool
   python3 python3-numpy python3-scipy python3-matplotlib
+  munge slurm-wlm
 )
 
 missing=()

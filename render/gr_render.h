@@ -71,6 +71,8 @@ typedef struct grRenderer_ {
   int floor_textured;      // 1 when a visible plane geom has a material (no floor lines)
   int has_floor;           // 1 when the world has a plane geom (planar shadows fall on it)
   double floor_height;     // height of the world's first plane geom (m)
+  int has_sky;             // 1 when the model has a skybox texture
+  float sky_rgb[3];        // its mean colour, 0..1 (fast quality's backdrop)
   int pelvis_body;         // body the camera follows
   int knee_body[2];        // tibial plateau body per knee (right, left), -1 when none
   int knee_distal[2];      // the body below it (talus), giving the tibia's axis; -1 when none

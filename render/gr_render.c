@@ -39,6 +39,8 @@ static const double kShadowFlatten = 1e-3;                        // planar shad
 static const double kShadowLift = 0.001;                          // planar shadow above floor (m)
 static const double kBackdropDistance = 30.0;                     // fast sky: backdrop distance
                                                                   // beyond the target (m)
+static const double kBackdropEmission = 100.0;                    // its emission (rgba / this:
+                                                                  // lights add ~1 %)
 
 void gr_options_default(grOptions* o) {
   memset(o, 0, sizeof(*o));
@@ -383,11 +385,11 @@ static void add_planar_shadows(grRenderer* r) {
 }
 
 // fast-quality sky: a large box of the sky colour kBackdropDistance beyond the camera target,
-// vertical, facing the camera, lit like the scene (the models' headlight and sun give about
-// its own colour)
+// vertical, facing the camera; emissive, so its colour does not depend on the viewpoint
 static void add_backdrop(grRenderer* r) {
   double az = r->cam.azimuth * mjPI / 180, f[2] = {cos(az), sin(az)};
-  float rgba[4] = {r->sky_rgb[0], r->sky_rgb[1], r->sky_rgb[2], 1.0f};
+  float rgba[4] = {1, 1, 1, 1};
+  for (int k = 0; k < 3; k++) rgba[k] = (float)(r->sky_rgb[k] / kBackdropEmission);
   mjvGeom* g = add_geom(&r->scn, mjGEOM_BOX, rgba);
   if (!g) return;
   // box axes (columns): right = forward x up, forward (horizontal), up
@@ -398,7 +400,7 @@ static void add_backdrop(grRenderer* r) {
   g->size[2] = 50;
   for (int k = 0; k < 2; k++) g->pos[k] = (float)(r->cam.lookat[k] + kBackdropDistance * f[k]);
   g->pos[2] = (float)r->cam.lookat[2];
-  g->emission = 0;
+  g->emission = (float)kBackdropEmission;
   g->specular = 0;
 }
 

@@ -132,7 +132,7 @@ IMPLANT_MESHES = {"femoral_component": "femoral_component", "tibial_tray": "tibi
 # FLOOR_SQUARE squares, bone and implant colours (RGBA)
 SKY_RGB = ("0.55 0.72 0.90", "0.93 0.95 0.97")
 FLOOR_RGB = ("0.80 0.80 0.78", "0.66 0.66 0.64")
-FLOOR_SQUARE = 0.5        # m
+FLOOR_SQUARE = 1.0        # m (MuJoCo maps a uniform texture with period 2 / texrepeat)
 BONE_RGBA = "0.92 0.89 0.82 1"
 IMPLANT_RGBA = "0.72 0.75 0.80 1"
 
@@ -2453,7 +2453,7 @@ class Converter:
         out.append('    <texture name="floor" type="2d" builtin="checker" rgb1="%s" rgb2="%s"'
                    ' width="64" height="64"/>' % FLOOR_RGB)
         out.append('    <material name="floor" texture="floor" texuniform="true"'
-                   ' texrepeat="%s %s"/>' % (fmt(0.5 / FLOOR_SQUARE), fmt(0.5 / FLOOR_SQUARE)))
+                   ' texrepeat="%s %s"/>' % (fmt(1.0 / FLOOR_SQUARE), fmt(1.0 / FLOOR_SQUARE)))
         out.append('    <material name="bone" rgba="%s" specular="0.2" shininess="0.2"/>'
                    % BONE_RGBA)
         out.append('    <material name="implant" rgba="%s" specular="0.8" shininess="0.7"/>'

@@ -137,7 +137,7 @@ int gr_renderer_create(mjModel* m, const grOptions* o, grRenderer* r, char* err,
   mjv_makeScene(m, &r->scn, 4000);
   mjv_defaultOption(&r->opt);
   // shadows: MuJoCo's shadow maps in high quality; in fast quality they tripled the cost of
-  // the bone meshes on llvmpipe, so add_planar_shadows draws the meshes flattened on the floor
+  // the bone meshes on llvmpipe, so add_planar_shadows draws flattened ellipsoids on the floor
   r->scn.flags[mjRND_SHADOW] = (mjtByte)(o->high_quality != 0);
   r->scn.flags[mjRND_REFLECTION] = (mjtByte)(o->high_quality != 0);
   // sky: the model's skybox texture (else black); in fast quality a backdrop of its mean

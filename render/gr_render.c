@@ -19,6 +19,7 @@ static const float kBoneRgba[4] = {0.92f, 0.89f, 0.82f, 1.0f};    // bones
 static const float kGrfRgba[4] = {0.10f, 0.75f, 0.20f, 1.0f};     // ground reaction arrows
 static const float kKneeRgba[4] = {1.00f, 0.70f, 0.05f, 1.0f};    // knee contact arrows
 static const float kLineRgba[4] = {0.55f, 0.55f, 0.58f, 1.0f};    // floor lines
+static const float kShadowRgba[4] = {0.30f, 0.30f, 0.31f, 1.0f};  // planar shadows (fast)
 static const double kBoneRadius = 0.018;                          // bone capsules (m)
 static const double kArrowWidth = 0.012;                          // GRF arrows (m)
 static const double kKneeArrowWidth = 0.026;                      // knee arrows, wider than
@@ -28,6 +29,18 @@ static const double kLookatHeight = 0.95;                         // camera targ
 static const double kViewHeight = 2.1;                            // height in view (m)
 static const int kFastSlices = 12;                                // fast quality: slices
 static const int kFastStacks = 6;                                 // fast quality: stacks
+static const double kFastPlaneGrid = 1.0;                         // fast quality: plane drawn in
+                                                                  // cells of this size (m)
+static const double kShadowHalfWidth = 1.6;                       // directional shadow map
+                                                                  // covers +-this (m)
+static const double kLightDistance = 3.0;                         // directional lights sit this
+                                                                  // far up-beam of the target (m)
+static const double kShadowFlatten = 1e-3;                        // planar shadow: height scale
+static const double kShadowLift = 0.001;                          // planar shadow above floor (m)
+static const double kBackdropDistance = 30.0;                     // fast sky: backdrop distance
+                                                                  // beyond the target (m)
+static const double kBackdropEmission = 100.0;                    // its emission (rgba / this:
+                                                                  // lights add ~1 %)
 
 void gr_options_default(grOptions* o) {
   memset(o, 0, sizeof(*o));
@@ -67,8 +80,9 @@ int gr_renderer_create(mjModel* m, const grOptions* o, grRenderer* r, char* err,
   r->osbuf = (unsigned char*)malloc((size_t)w * h * 4);
   r->rows = (unsigned char*)malloc((size_t)w * h * 3);
   r->tendon_actuator = (int*)malloc(sizeof(int) * (size_t)(m->ntendon > 0 ? m->ntendon : 1));
+  r->body_mesh = (unsigned char*)calloc((size_t)m->nbody, 1);
   r->d = mj_makeData(m);
-  if (!r->osbuf || !r->rows || !r->tendon_actuator || !r->d) {
+  if (!r->osbuf || !r->rows || !r->tendon_actuator || !r->body_mesh || !r->d) {
     SET_ERR("out of memory for a %dx%d renderer", w, h);
     gr_renderer_free(r);
     return -1;
@@ -91,11 +105,21 @@ int gr_renderer_create(mjModel* m, const grOptions* o, grRenderer* r, char* err,
   m->vis.global.offheight = h;
   m->vis.quality.offsamples = o->high_quality ? 4 : 0;
   m->vis.quality.shadowsize = o->high_quality ? 4096 : 1024;
+  // directional shadow map: +-kShadowHalfWidth around the light's axis, which place_lights
+  // aims at the camera target (MuJoCo sizes it as shadowclip x stat.extent)
+  if (m->stat.extent > 0) m->vis.map.shadowclip = (float)(kShadowHalfWidth / m->stat.extent);
   // tessellation of spheres, capsules, cylinders: llvmpipe's cost is in the triangles (fast:
   // 12 x 6 instead of MuJoCo's 28 x 16 gave about 4x the frame rate at 1280x720)
   if (!o->high_quality) {
     if (m->vis.quality.numslices > kFastSlices) m->vis.quality.numslices = kFastSlices;
     if (m->vis.quality.numstacks > kFastStacks) m->vis.quality.numstacks = kFastStacks;
+  }
+  // planes: MuJoCo draws up to 200 x 200 cells of geom size[2] (the models' 0.1 m: 20,000
+  // textured quads for the 10 x 5 m floor); size[2] is drawing-only for a plane
+  for (int g = 0; g < m->ngeom && !o->high_quality; g++) {
+    if (m->geom_type[g] == mjGEOM_PLANE && m->geom_size[3 * g + 2] < kFastPlaneGrid) {
+      m->geom_size[3 * g + 2] = kFastPlaneGrid;
+    }
   }
   for (int i = 0; i < m->ntendon; i++) {
     if (m->tendon_width[i] < kTendonMinWidth) m->tendon_width[i] = kTendonMinWidth;
@@ -112,9 +136,40 @@ int gr_renderer_create(mjModel* m, const grOptions* o, grRenderer* r, char* err,
   mjv_defaultScene(&r->scn);
   mjv_makeScene(m, &r->scn, 4000);
   mjv_defaultOption(&r->opt);
+  // shadows: MuJoCo's shadow maps in high quality; in fast quality they tripled the cost of
+  // the bone meshes on llvmpipe, so add_planar_shadows draws flattened ellipsoids on the floor
   r->scn.flags[mjRND_SHADOW] = (mjtByte)(o->high_quality != 0);
   r->scn.flags[mjRND_REFLECTION] = (mjtByte)(o->high_quality != 0);
-  r->scn.flags[mjRND_SKYBOX] = 0;
+  // sky: the model's skybox texture (else black); in fast quality a backdrop of its mean
+  // colour instead (MuJoCo's cube-mapped skybox cost 5-8 ms of CPU per 1280x720 frame on
+  // llvmpipe, as much as the bone meshes)
+  for (int t = 0; t < m->ntex && !r->has_sky; t++) {
+    if (m->tex_type[t] != mjTEXTURE_SKYBOX) continue;
+    long n = (long)m->tex_width[t] * m->tex_height[t];
+    double sum[3] = {0, 0, 0};
+    for (long i = 0; i < n; i++) {
+      for (int k = 0; k < 3; k++) sum[k] += m->tex_rgb[m->tex_adr[t] + 3 * i + k];
+    }
+    for (int k = 0; k < 3; k++) r->sky_rgb[k] = n > 0 ? (float)(sum[k] / n / 255.0) : 0.0f;
+    r->has_sky = 1;
+  }
+  r->scn.flags[mjRND_SKYBOX] = (mjtByte)(o->high_quality != 0);
+  // bodies drawn by a mesh of a visible group get no stick-figure capsule; a floor with a
+  // material (the models' checker texture) needs no drawn lines
+  for (int g = 0; g < m->ngeom; g++) {
+    int group = m->geom_group[g];
+    if (group < 0 || group >= mjNGROUP || !r->opt.geomgroup[group]) continue;
+    if (m->geom_type[g] == mjGEOM_MESH) r->body_mesh[m->geom_bodyid[g]] = 1;
+    if (m->geom_type[g] == mjGEOM_PLANE && m->geom_matid[g] >= 0) r->floor_textured = 1;
+    if (m->geom_type[g] == mjGEOM_PLANE && m->geom_bodyid[g] == 0 && !r->has_floor) {
+      r->has_floor = 1;
+      r->floor_height = m->geom_pos[3 * g + 2];
+    }
+  }
+  // with bone meshes the contact spheres (group 2) would hide the feet: not drawn
+  for (int b = 0; b < m->nbody; b++) {
+    if (r->body_mesh[b]) r->opt.geomgroup[2] = 0;
+  }
   mjv_defaultCamera(&r->cam);
   r->cam.type = mjCAMERA_FREE;
   // which actuator drives each tendon (colours)
@@ -152,17 +207,26 @@ void gr_renderer_free(grRenderer* r) {
   free(r->osbuf);
   free(r->rows);
   free(r->tendon_actuator);
+  free(r->body_mesh);
   memset(r, 0, sizeof(*r));
 }
 
 // ---------------------------------------------------------------------------------------------
 // decoration
 
-// next free geom of the scene, initialised as a decoration, or NULL when full
+// next free geom of the scene, initialised as a decoration, or NULL when full. The slot is
+// cleared first: MuJoCo 2.2's mjv_initGeom leaves objtype/objid as the previous frame left
+// them, and a stale mjOBJ_TENDON would have decorate() recolour the decoration
 static mjvGeom* add_geom(mjvScene* scn, int type, const float rgba[4]) {
   if (scn->ngeom >= scn->maxgeom) return NULL;
   mjvGeom* g = scn->geoms + scn->ngeom++;
+  memset(g, 0, sizeof(*g));
   mjv_initGeom(g, type, NULL, NULL, NULL, rgba);
+  g->objtype = mjOBJ_UNKNOWN;
+  g->objid = -1;
+  g->dataid = -1;
+  g->texid = -1;
+  g->segid = -1;
   g->category = mjCAT_DECOR;
   return g;
 }
@@ -203,10 +267,10 @@ static void decorate(grRenderer* r, const grMotion* mo, const grFrameForces* ff)
       activation_rgba(v, g->rgba);
     }
   }
-  // bones: parent origin -> child origin, for bodies that move
+  // bones without a mesh: parent origin -> child origin, for bodies that move
   for (int b = 1; b < m->nbody; b++) {
     int p = m->body_parentid[b];
-    if (p <= 0 || m->body_weldid[p] == 0) continue;
+    if (p <= 0 || m->body_weldid[p] == 0 || r->body_mesh[p]) continue;
     const double* a = d->xpos + 3 * p;
     const double* c = d->xpos + 3 * b;
     double dx[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
@@ -231,7 +295,9 @@ static void decorate(grRenderer* r, const grMotion* mo, const grFrameForces* ff)
     for (int k = 0; k < 3; k++) tail[k] = p[k] - len * u[k];
     add_connector(scn, mjGEOM_ARROW, kKneeArrowWidth, tail, p, kKneeRgba);
   }
-  // floor lines every 0.5 m across the walking direction, around the camera target
+  // floor lines every 0.5 m across the walking direction, around the camera target (a
+  // textured floor shows the progression itself)
+  if (r->floor_textured) return;
   double x0 = floor((r->cam.lookat[0] - 4.0) / 0.5) * 0.5;
   for (int i = 0; i <= 16; i++) {
     double x = x0 + 0.5 * i;
@@ -265,6 +331,79 @@ static void place_camera(grRenderer* r) {
   }
 }
 
+// directional lights (not the headlight) follow the camera target, so the shadow map, which
+// MuJoCo centres on the light's axis, covers the body wherever it walks
+static void place_lights(grRenderer* r) {
+  for (int i = 0; i < r->scn.nlight; i++) {
+    mjvLight* l = r->scn.lights + i;
+    if (!l->directional || l->headlight) continue;
+    double dir[3] = {l->dir[0], l->dir[1], l->dir[2]};
+    if (mju_normalize3(dir) < 1e-6) continue;
+    for (int k = 0; k < 3; k++) l->pos[k] = (float)(r->cam.lookat[k] - kLightDistance * dir[k]);
+  }
+}
+
+// fast-quality shadows: for every mesh geom of the model, the ellipsoid of its bounding box
+// (MuJoCo's geom size of a mesh: half-sizes in the mesh's principal frame) projected along the
+// first directional light (else straight down) onto the floor plane z = floor_height,
+// flattened to kShadowFlatten of its height (non-singular, so its normals point up and it is
+// lit like the floor) and kShadowLift above it, in one dark colour. Ellipsoids, not the
+// meshes: projecting the meshes themselves (62,000 triangles) halved the frame rate on
+// llvmpipe, 83 ellipsoids of 12 x 6 cost little; the shadow is a soft body outline
+static void add_planar_shadows(grRenderer* r) {
+  mjvScene* scn = &r->scn;
+  double dir[3] = {0, 0, -1};
+  for (int i = 0; i < scn->nlight; i++) {
+    const mjvLight* l = scn->lights + i;
+    double u[3] = {l->dir[0], l->dir[1], l->dir[2]};
+    if (l->directional && !l->headlight && mju_normalize3(u) > 1e-6 && u[2] < -0.2) {
+      mju_copy3(dir, u);
+      break;
+    }
+  }
+  double ax = -dir[0] / dir[2], ay = -dir[1] / dir[2], h = r->floor_height;
+  int n = scn->ngeom;
+  for (int i = 0; i < n; i++) {
+    const mjvGeom* g = scn->geoms + i;
+    if (g->type != mjGEOM_MESH || g->category == mjCAT_DECOR) continue;
+    mjvGeom* s = add_geom(scn, mjGEOM_ELLIPSOID, kShadowRgba);
+    if (!s) return;
+    for (int k = 0; k < 3; k++) s->size[k] = g->size[k];
+    // world x = pos + mat x_local; projected x' = x + a (z - h), y' = y + b (z - h),
+    // z' = h + lift + flatten (z - h)
+    for (int c = 0; c < 3; c++) {
+      s->mat[c] = (float)(g->mat[c] + ax * g->mat[6 + c]);
+      s->mat[3 + c] = (float)(g->mat[3 + c] + ay * g->mat[6 + c]);
+      s->mat[6 + c] = (float)(kShadowFlatten * g->mat[6 + c]);
+    }
+    double dz = g->pos[2] - h;
+    s->pos[0] = (float)(g->pos[0] + ax * dz);
+    s->pos[1] = (float)(g->pos[1] + ay * dz);
+    s->pos[2] = (float)(h + kShadowLift + kShadowFlatten * dz);
+    s->specular = 0;
+  }
+}
+
+// fast-quality sky: a large box of the sky colour kBackdropDistance beyond the camera target,
+// vertical, facing the camera; emissive, so its colour does not depend on the viewpoint
+static void add_backdrop(grRenderer* r) {
+  double az = r->cam.azimuth * mjPI / 180, f[2] = {cos(az), sin(az)};
+  float rgba[4] = {1, 1, 1, 1};
+  for (int k = 0; k < 3; k++) rgba[k] = (float)(r->sky_rgb[k] / kBackdropEmission);
+  mjvGeom* g = add_geom(&r->scn, mjGEOM_BOX, rgba);
+  if (!g) return;
+  // box axes (columns): right = forward x up, forward (horizontal), up
+  float mat[9] = {(float)f[1], (float)f[0], 0, (float)-f[0], (float)f[1], 0, 0, 0, 1};
+  memcpy(g->mat, mat, sizeof(mat));
+  g->size[0] = 80;
+  g->size[1] = 0.1f;
+  g->size[2] = 50;
+  for (int k = 0; k < 2; k++) g->pos[k] = (float)(r->cam.lookat[k] + kBackdropDistance * f[k]);
+  g->pos[2] = (float)r->cam.lookat[2];
+  g->emission = (float)kBackdropEmission;
+  g->specular = 0;
+}
+
 void gr_renderer_frame(grRenderer* r, const grMotion* mo, double t, unsigned char* rgb) {
   mjModel* m = r->m;
   mjData* d = r->d;
@@ -277,6 +416,9 @@ void gr_renderer_frame(grRenderer* r, const grMotion* mo, double t, unsigned cha
   mj_tendon(m, d);
   place_camera(r);
   mjv_updateScene(m, d, &r->opt, NULL, &r->cam, mjCAT_ALL, &r->scn);
+  place_lights(r);
+  if (!r->o.high_quality && r->has_floor) add_planar_shadows(r);
+  if (!r->o.high_quality && r->has_sky) add_backdrop(r);
   decorate(r, mo, &ff);
   mjrRect vp = {0, 0, r->o.width, r->o.height};
   mjr_render(vp, &r->scn, &r->con);

@@ -2,23 +2,29 @@
 // rasterizer: no display, no GPU, no EGL or GLX), scene decoration, and the three jobs of
 // `gaitsim render`: a video (mp4 and/or numbered PNG frames), one picture, a filmstrip.
 //
-// Scene: the model's own geoms (floor, contact spheres) and tendons, plus
-//  - bones: a capsule from each body's origin to each child body's origin (the bundled model
-//    has no bone meshes), bodies welded to the world excluded;
+// Scene: the model's own geoms (floor, its material, bone and implant meshes; contact spheres
+// only when the model has no meshes), skybox, lights and tendons, plus
+//  - bones of bodies without a mesh: a capsule from the body's origin to each child body's
+//    origin, bodies welded to the world excluded;
 //  - muscles: each tendon driven by an actuator coloured by its activation (or excitation)
 //    from blue (0) to red (1);
 //  - ground reaction force arrows from the centre of pressure, grf_scale m per body weight;
 //  - knee contact force arrows along the tibia onto the tibial plateau (body tibial_tray or
 //    tibia, and tibia_l), knee_scale m per body weight;
-//  - floor lines every 0.5 m (so forward progression shows against the followed camera);
+//  - floor lines every 0.5 m when the floor has no material (the models' checker shows the
+//    forward progression against the followed camera itself);
+//  - shadows: in fast quality each mesh flattened onto the floor along the model's first
+//    directional light (planar shadows; no self-shadowing); in high quality MuJoCo's shadow
+//    maps, with directional lights moved to follow the camera target;
 //  - a text overlay: time (s) and % of the cycle with the cycle number.
 // The camera follows the pelvis (body "pelvis", else body 1): side (from the right), front, or
 // follow (three-quarter view from behind on the right).
 //
 // Set-up order for OSMesa (STACK.md): context -> make current -> offscreen size in the model ->
-// mjr_makeContext -> mjr_setBuffer(mjFB_OFFSCREEN). Speed: default (fast) quality has no
-// shadows, reflections or multisampling and tessellates round geoms 12 x 6 (MuJoCo's default
-// 28 x 16); high quality turns on all three (4x MSAA) and keeps the model's tessellation.
+// mjr_makeContext -> mjr_setBuffer(mjFB_OFFSCREEN). Speed: default (fast) quality has planar
+// shadows, no reflections or multisampling, tessellates round geoms 12 x 6 (MuJoCo's default
+// 28 x 16) and draws planes in 1 m cells; high quality turns on MuJoCo's shadow maps,
+// reflections and 4x MSAA and keeps the model's tessellation.
 //
 // Errors: 0 on success, -1 with one line in err (errsz bytes). Nothing is printed or exits.
 #ifndef GAITSIM_RENDER_GR_RENDER_H_
@@ -36,7 +42,7 @@ typedef enum grCameraKind_ {
 
 typedef struct grOptions_ {
   int width, height;    // frame size (pixels)
-  int high_quality;     // 1: shadows, reflections and 4x multisampling; 0: none (fast)
+  int high_quality;     // 1: shadow maps, reflections, 4x multisampling; 0: planar shadows (fast)
   grCameraKind camera;  // viewpoint
   int overlay;          // 1: time and % cycle text in the top left corner
   double grf_scale;     // ground reaction arrow length per body weight (m/BW)
@@ -48,8 +54,9 @@ typedef struct grOptions_ {
 void gr_options_default(grOptions* o);
 
 typedef struct grRenderer_ {
-  mjModel* m;              // the model (borrowed; its vis.global.offwidth/offheight, quality
-                           // and tendon_width are set by gr_renderer_create)
+  mjModel* m;              // the model (borrowed; its vis.global.offwidth/offheight, quality,
+                           // map.shadowclip, tendon_width and (fast) the plane geoms' drawing
+                           // grid size[2] are set by gr_renderer_create)
   mjData* d;               // pose being drawn (owned)
   void* osmesa;            // OSMesa context (OSMesaContext)
   unsigned char* osbuf;    // OSMesa's default framebuffer (width x height x 4 bytes)
@@ -60,6 +67,12 @@ typedef struct grRenderer_ {
   mjvCamera cam;           // free camera
   grOptions o;             // options the renderer was made with
   int* tendon_actuator;    // actuator driving each tendon, -1 for none (ntendon)
+  unsigned char* body_mesh;  // 1 where the body carries a visible mesh geom (nbody)
+  int floor_textured;      // 1 when a visible plane geom has a material (no floor lines)
+  int has_floor;           // 1 when the world has a plane geom (planar shadows fall on it)
+  double floor_height;     // height of the world's first plane geom (m)
+  int has_sky;             // 1 when the model has a skybox texture
+  float sky_rgb[3];        // its mean colour, 0..1 (fast quality's backdrop)
   int pelvis_body;         // body the camera follows
   int knee_body[2];        // tibial plateau body per knee (right, left), -1 when none
   int knee_distal[2];      // the body below it (talus), giving the tibia's axis; -1 when none

@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Rendering speed of `gaitsim render` at 1280x720, default (fast) quality, side camera, overlay:
+# Rendering speed of `gaitsim render` at 1280x720, default (fast) quality (bone meshes, sky
+# backdrop, checker floor, planar shadows with the bundled model), side camera, overlay:
 # the fixture solution, 2 cycles at 60 fps (133 frames) into an H.264 mp4 through ffmpeg,
 # REPEATS times. Each run's frames/s is what the command reports: frames / wall time of the
 # render loop, which includes rendering (OSMesa llvmpipe), pixel read-back and the ffmpeg encode

@@ -10,6 +10,13 @@ knee_contact.sto at the same rows. Activations ("<muscle>.activation" in states.
 excitations (controls.sto) are SYNTHETIC, not a solution: a = 0.05 + 0.6 sin^2(pi (phase +
 i / nmuscle)) for muscle i, so the colours vary across muscles and time; a test fixture, nothing
 to read physiology from. Deterministic: the same inputs give the same bytes. Standard library only.
+
+The golden image of tests/test_render.c renders this fixture on mjmodels/jw_fullbody.xml (its
+bone meshes, sky and checker floor included): after changing the fixture, the model's display
+geometry (mjmodels/meshes/, scripts/osim2mjcf.py) or the renderer, rewrite it with
+  GAITSIM_UPDATE_GOLDEN=1 build/tests/test_render
+(bit-identical to `gaitsim render tests/fixtures/solution_small --at 0.35 --size 160x120
+--png tests/fixtures/render_golden_160x120.png`) and look at it before committing.
 """
 import argparse
 import math

@@ -123,6 +123,19 @@ FOOT_FLAT_SPEED = 0.1
 # standard gravity (m/s^2), written into the MJCF's <option gravity>
 GRAVITY = 9.80665
 
+# display geometry (mjmodels/meshes/README.md, scripts/make_bone_meshes.py): meshes the .osim does
+# not reference, added to a body (a whole pelvis: the .osim draws the right half only), and the
+# implant meshes the .osim names but are not public, replaced by files made from the prosthesis
+EXTRA_MESHES = {"pelvis": ["sacrum", "l_pelvis"]}
+IMPLANT_MESHES = {"femoral_component": "femoral_component", "tibial_tray": "tibial_insert"}
+# scene of the generated models (visual only): sky gradient (top, horizon), floor checker of
+# FLOOR_SQUARE squares, bone and implant colours (RGBA)
+SKY_RGB = ("0.55 0.72 0.90", "0.93 0.95 0.97")
+FLOOR_RGB = ("0.80 0.80 0.78", "0.66 0.66 0.64")
+FLOOR_SQUARE = 1.0        # m (MuJoCo maps a uniform texture with period 2 / texrepeat)
+BONE_RGBA = "0.92 0.89 0.82 1"
+IMPLANT_RGBA = "0.72 0.75 0.80 1"
+
 EPS_ZERO = 1e-8           # |default value| below which a coordinate default counts as 0
 FD_STEP = 1e-5            # central-difference step for moment arms (rad or m)
 
@@ -342,6 +355,38 @@ def parse_function(elem):
 # ------------------------------------------------------------------------------------------------
 # OpenSim model: bodies, joints (with offset frames), coordinates, couplers, muscles
 # ------------------------------------------------------------------------------------------------
+
+def osim_meshes(path):
+    """(body, mesh base name, [sx, sy, sz]) for every <Mesh> attached to a body of the .osim, in
+    document order (the display geometry; JW's meshes sit in their body's own frame, socket_frame
+    '..', mjmodels/meshes/README.md)."""
+    root = ET.parse(path).getroot()
+    out = []
+    for body in root.iter("Body"):
+        for mesh in body.iter("Mesh"):
+            name = os.path.splitext((mesh.findtext("mesh_file") or "").strip())[0]
+            scale = floats(mesh.findtext("scale_factors") or "1 1 1")
+            out.append((body.get("name"), name, scale))
+    return out
+
+
+def display_meshes(osim_path, mesh_dir):
+    """body -> [(mesh asset name, scale, geom class)] of the model's visual-only geoms: the
+    .osim's meshes (implant ones replaced, IMPLANT_MESHES) plus EXTRA_MESHES, each as an STL of
+    scripts/make_bone_meshes.py in mesh_dir (all must exist)."""
+    meshes = {}
+    for body, name, scale in osim_meshes(osim_path):
+        cls = "implant" if name in IMPLANT_MESHES else "bone"
+        meshes.setdefault(body, []).append((IMPLANT_MESHES.get(name, name), scale, cls))
+    for body, names in EXTRA_MESHES.items():
+        meshes.setdefault(body, []).extend((n, [1.0, 1.0, 1.0], "bone") for n in names)
+    missing = [n for lst in meshes.values() for n, _, _ in lst
+               if not os.path.isfile(os.path.join(mesh_dir, n + ".stl"))]
+    if missing:
+        raise SystemExit("osim2mjcf.py: %s: no %s.stl (%d missing; make them with "
+                         "scripts/make_bone_meshes.py)" % (mesh_dir, missing[0], len(missing)))
+    return meshes
+
 
 def last_name(path):
     """'/bodyset/femur' -> 'femur', '/jointset/knee_l/knee_flexion_l' -> 'knee_flexion_l'."""
@@ -2151,8 +2196,9 @@ def standing_pose(model, zero, frames, soles):
 
 
 class Converter:
-    def __init__(self, model, metabolic, frames, osim_name, heel_strikes, grf_path):
+    def __init__(self, model, metabolic, frames, osim_name, heel_strikes, grf_path, meshes):
         self.model = model
+        self.meshes = meshes     # body -> [(mesh, scale, class)] (display_meshes)
         self.metabolic = metabolic
         self.frames = frames
         self.osim_name = osim_name
@@ -2302,6 +2348,11 @@ class Converter:
                 inert = 'fullinertia="%s"' % fvec([ixx, iyy, izz, ixy, ixz, iyz])
             out.append('%s<inertial pos="%s" mass="%s" %s/>' % (pad, fvec(b["com"]),
                                                                 fmt(b["mass"], 12), inert))
+        elif self.meshes.get(body):
+            raise SystemExit("osim2mjcf.py: body %s has meshes but no mass: its display geoms "
+                             "would get mass" % body)
+        for mesh, _, cls in self.meshes.get(body, []):
+            out.append('%s<geom name="%s_%s" class="%s" mesh="%s"/>' % (pad, cls, mesh, cls, mesh))
         for spec in self.wrap_geoms.get(body, []):
             size = fmt(spec["radius"]) if spec["type"] == "sphere" else \
                 "%s %s" % (fmt(spec["radius"]), fmt(max(spec["half"], spec["radius"])))
@@ -2354,11 +2405,14 @@ class Converter:
         out.append("  Contact spheres calibrated on the trial (IK_ngait_og5 foot-flat frames, the")
         out.append("    heel strikes of mjmodels/trials/jw_ngait_og5/trial.json and the vertical")
         out.append("    GRF of its grf.mot): mjmodels/README.md, Contact spheres and standing pose.")
+        out.append("  Display meshes (visual only, no mass, no collision): meshes/, made by")
+        out.append("    scripts/make_bone_meshes.py; provenance and licence in meshes/README.md.")
         out.append("  Layout of actuator and geom user rows: callbacks/gs_model_layout.h;")
         out.append("    choices and errors: mjmodels/README.md.")
         out.append("-->")
         out.append('<mujoco model="jw_fullbody">')
-        out.append('  <compiler angle="radian" autolimits="true" balanceinertia="true">')
+        out.append('  <compiler angle="radian" autolimits="true" balanceinertia="true"'
+                   ' meshdir="meshes">')
         out.append('    <lengthrange useexisting="true" mode="muscle"/>')
         out.append("  </compiler>")
         out.append('  <option timestep="0.001" gravity="0 0 -%s" integrator="Euler"/>' % fmt(GRAVITY))
@@ -2380,12 +2434,45 @@ class Converter:
                    ' friction="0.8 0.005 0.0001" rgba="0.9 0.6 0.2 1" user="%s"/>'
                    % fvec(CONTACT_USER))
         out.append("    </default>")
+        # display meshes: no collision, no mass (every body carrying one has an <inertial>)
+        for cls in ("bone", "implant"):
+            out.append('    <default class="%s">' % cls)
+            out.append('      <geom type="mesh" contype="0" conaffinity="0" group="1"'
+                       ' material="%s"/>' % cls)
+            out.append("    </default>")
         out.append('    <tendon width="0.002" rgba="0.7 0.1 0.1 1"/>')
         out.append("  </default>")
+        out.append("  <visual>")
+        out.append('    <headlight ambient="0.3 0.3 0.3" diffuse="0.35 0.35 0.35"'
+                   ' specular="0.05 0.05 0.05"/>')
+        out.append('    <quality shadowsize="2048"/>')
+        out.append("  </visual>")
+        out.append("  <asset>")
+        out.append('    <texture name="sky" type="skybox" builtin="gradient" rgb1="%s" rgb2="%s"'
+                   ' width="128" height="128"/>' % SKY_RGB)
+        out.append('    <texture name="floor" type="2d" builtin="checker" rgb1="%s" rgb2="%s"'
+                   ' width="64" height="64"/>' % FLOOR_RGB)
+        out.append('    <material name="floor" texture="floor" texuniform="true"'
+                   ' texrepeat="%s %s"/>' % (fmt(1.0 / FLOOR_SQUARE), fmt(1.0 / FLOOR_SQUARE)))
+        out.append('    <material name="bone" rgba="%s" specular="0.2" shininess="0.2"/>'
+                   % BONE_RGBA)
+        out.append('    <material name="implant" rgba="%s" specular="0.8" shininess="0.7"/>'
+                   % IMPLANT_RGBA)
+        done = set()
+        for body in m.body_order:
+            for mesh, scale, _ in self.meshes.get(body, []):
+                if mesh in done:
+                    raise SystemExit("osim2mjcf.py: mesh %s used twice" % mesh)
+                done.add(mesh)
+                out.append('    <mesh name="%s" file="%s.stl" scale="%s"/>' % (
+                    mesh, mesh, fvec(scale)))
+        out.append("  </asset>")
         out.append("  <worldbody>")
         out.append('    <geom name="floor" type="plane" size="10 5 0.1" contype="1" conaffinity="1"'
-                   ' group="0" rgba="0.8 0.8 0.8 1"/>')
-        out.append('    <light name="sun" pos="0 0 4" dir="0 0 -1" directional="true"/>')
+                   ' group="0" material="floor"/>')
+        # sun from above, in front and to the right of the walker (shadows fall behind-left)
+        out.append('    <light name="sun" pos="1 -1 4" dir="-0.35 0.45 -1" directional="true"'
+                   ' diffuse="0.75 0.75 0.72" specular="0.2 0.2 0.2"/>')
         out.append('    <body name="ground" quat="%s">' % fvec(quat_from_mat(
             axis_angle([1.0, 0.0, 0.0], math.pi / 2.0))))
         for child, j, rev in self.children["ground"]:
@@ -2532,8 +2619,12 @@ def main():
     for name, short, old, new in floor_fibre_shortening(model, frames):
         print("lts %-11s lM/lopt min %.3f: %.4f -> %.4f m (%+.1f %%)" % (
             name, short, old, new, 100.0 * (new / old - 1.0)))
+    # display meshes: meshes/ next to the model (its meshdir)
+    meshes = display_meshes(args.osim, os.path.join(os.path.dirname(os.path.abspath(args.out)),
+                                                    "meshes"))
     conv = Converter(model, metabolic, frames, os.path.basename(args.osim), heel_strikes,
-                     os.path.join(os.path.dirname(os.path.abspath(args.trial_events)), "grf.mot"))
+                     os.path.join(os.path.dirname(os.path.abspath(args.trial_events)), "grf.mot"),
+                     meshes)
     for side in ("r", "l"):
         sole = conv.soles[side]
         print("sole %s: normal %s, offset %.4f m in the calcaneus frame (%d foot-flat frames, "

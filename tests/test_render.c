@@ -24,6 +24,7 @@
 #include <mujoco/mujoco.h>
 
 #include "callbacks/gs_mujoco.h"
+#include "callbacks/gs_physics.h"
 #include "render/gr_image.h"
 #include "render/gr_motion.h"
 #include "render/gr_render.h"
@@ -133,10 +134,19 @@ static void golden_image_should_match_within_tolerance(void) {
     printf("golden: mean |diff| %.4f per channel, max %d (tolerance %.1f)\n", mad, maxdiff,
            kGoldenTolerance);
     EXPECT_NEAR(0, mad, kGoldenTolerance);
-    // the picture is not blank: the model covers a good number of pixels
-    long lit = 0;
-    for (int i = 0; i < 160 * 120 * 3; i++) lit += img[i] != img[i % 3];
-    EXPECT_TRUE(lit > 500);
+    // the scene: a sky (top right pixel light blue, not the black of no skybox) over a
+    // checker floor (the bottom row spans two grey levels, > 30 apart)
+    const unsigned char* sky = img + (5 * 160 + 155) * 3;
+    printf("sky pixel %d %d %d\n", sky[0], sky[1], sky[2]);
+    EXPECT_TRUE(sky[2] > 150 && sky[2] > sky[0] + 20);
+    int lo = 255, hi = 0;
+    for (int x = 0; x < 160; x++) {
+      int v = img[(119 * 160 + x) * 3 + 1];
+      lo = v < lo ? v : lo;
+      hi = v > hi ? v : hi;
+    }
+    printf("floor row green %d..%d\n", lo, hi);
+    EXPECT_TRUE(hi - lo > 30);
     // a test that cannot fail is a defect: another pose, and no GRF arrows, are detected
     unsigned char* other = render_at(&r, &mo, 0.45);
     double mad_pose = other ? gr_image_mean_abs_diff(other, golden, 160, 120, NULL) : 0;
@@ -150,6 +160,14 @@ static void golden_image_should_match_within_tolerance(void) {
     double mad_bare = bare ? gr_image_mean_abs_diff(bare, golden, 160, 120, NULL) : 0;
     printf("golden vs no arrows and no overlay: %.4f\n", mad_bare);
     EXPECT_TRUE(mad_bare > kGoldenTolerance);
+    // and the bones: that frame without the bone meshes (group 1) differs from it as much
+    r.opt.geomgroup[1] = 0;
+    unsigned char* boneless = render_at(&r, &mo, 0.35);
+    double mad_boneless =
+        boneless && bare ? gr_image_mean_abs_diff(boneless, bare, 160, 120, NULL) : 0;
+    printf("no arrows and no overlay vs also no bone meshes: %.4f\n", mad_boneless);
+    EXPECT_TRUE(mad_boneless > kGoldenTolerance);
+    free(boneless);
     free(bare);
   }
   free(img);
@@ -157,6 +175,126 @@ static void golden_image_should_match_within_tolerance(void) {
   gr_renderer_free(&r);
   gr_motion_free(&mo);
   mj_deleteModel(m);
+}
+
+// copy of the model file at `src` without its display meshes (the <mesh> assets and the geoms
+// of class bone / implant, one per line as scripts/osim2mjcf.py writes them) into `dst`;
+// returns the number of lines left out
+static int write_without_meshes(const char* src, const char* dst) {
+  FILE* in = fopen(src, "r");
+  FILE* out = fopen(dst, "w");
+  int dropped = 0;
+  char line[8192];
+  while (in && out && fgets(line, sizeof(line), in)) {
+    if (strstr(line, "<mesh ") || strstr(line, "class=\"bone\" mesh=") ||
+        strstr(line, "class=\"implant\" mesh=")) {
+      dropped++;
+      continue;
+    }
+    fputs(line, out);
+  }
+  if (in) fclose(in);
+  if (out) fclose(out);
+  return dropped;
+}
+
+// bitwise equality of n values, printing the first difference
+static int same_bits(const char* what, const mjtNum* a, const mjtNum* b, int n) {
+  for (int i = 0; i < n; i++) {
+    if (memcmp(a + i, b + i, sizeof(mjtNum)) != 0) {
+      fprintf(stderr, "%s[%d]: %.17g with meshes, %.17g without\n", what, i, a[i], b[i]);
+      return 0;
+    }
+  }
+  return 1;
+}
+
+// step both models from the standing keyframe, all controls at 0.3, and compare the state
+static void expect_same_motion(const mjModel* a, const mjModel* b, int steps) {
+  mjData* da = mj_makeData(a);
+  mjData* db = mj_makeData(b);
+  mj_resetDataKeyframe(a, da, 0);
+  mj_resetDataKeyframe(b, db, 0);
+  for (int k = 0; k < a->nu; k++) da->ctrl[k] = db->ctrl[k] = 0.3;
+  for (int s = 0; s < steps; s++) {
+    mj_step(a, da);
+    mj_step(b, db);
+  }
+  EXPECT_TRUE(mju_norm(da->qvel, a->nv) > 1e-3);  // it moved
+  EXPECT_TRUE(same_bits("qpos", da->qpos, db->qpos, a->nq));
+  EXPECT_TRUE(same_bits("qvel", da->qvel, db->qvel, a->nv));
+  EXPECT_TRUE(same_bits("qacc", da->qacc, db->qacc, a->nv));
+  EXPECT_TRUE(same_bits("act", da->act, db->act, a->na));
+  EXPECT_TRUE(same_bits("qfrc_passive", da->qfrc_passive, db->qfrc_passive, a->nv));
+  EXPECT_EQ_INT(db->ncon, da->ncon);
+  mj_deleteData(da);
+  mj_deleteData(db);
+}
+
+// The bone and implant meshes are display only: each model file against its own copy without
+// them has the same masses and inertias, bit for bit, and moves the same, bit for bit, for
+// 200 steps in stock MuJoCo (its contact solver, no gaitsim callback) and with gaitsim's
+// physics (muscles, foot contact and, in the knee6 model, the implant knee's surrogate).
+static void display_meshes_should_change_no_physics(void) {
+  static const char* const models[] = {"/mjmodels/jw_fullbody.xml",
+                                       "/mjmodels/jw_fullbody_knee6.xml",
+                                       "/mjmodels/gait2d.xml"};
+  enum { kModels = 3 };
+  mjModel* with[kModels] = {NULL};
+  mjModel* without[kModels] = {NULL};
+  char err[1024], path[1024], bare[] = "/tmp/gaitsim_test_render_XXXXXX";
+  int fd = mkstemp(bare);
+  EXPECT_TRUE(fd >= 0);
+  if (fd < 0) return;
+  close(fd);
+  for (int i = 0; i < kModels; i++) {
+    snprintf(path, sizeof(path), "%s%s", GAITSIM_SOURCE_DIR, models[i]);
+    with[i] = gs_model_load(path, err, sizeof(err));
+    EXPECT_TRUE(with[i] != NULL);
+    EXPECT_TRUE(write_without_meshes(path, bare) >= 2 * 83);  // 83 assets + 83 geoms
+    without[i] = gs_model_load(bare, err, sizeof(err));
+    EXPECT_TRUE(without[i] != NULL);
+    if (!with[i] || !without[i]) {
+      fprintf(stderr, "%s: %s\n", models[i], err);
+      continue;
+    }
+    const mjModel* a = with[i];
+    const mjModel* b = without[i];
+    // 83 meshes (81 bones, 2 implant parts), every mesh geom visual only
+    EXPECT_EQ_INT(83, a->nmesh);
+    EXPECT_EQ_INT(0, b->nmesh);
+    EXPECT_EQ_INT(b->ngeom + 83, a->ngeom);
+    for (int g = 0; g < a->ngeom; g++) {
+      if (a->geom_type[g] != mjGEOM_MESH) continue;
+      EXPECT_EQ_INT(0, a->geom_contype[g]);
+      EXPECT_EQ_INT(0, a->geom_conaffinity[g]);
+      EXPECT_EQ_INT(1, a->geom_group[g]);
+    }
+    EXPECT_EQ_INT(b->nbody, a->nbody);
+    if (a->nbody != b->nbody) continue;
+    EXPECT_TRUE(same_bits("body_mass", a->body_mass, b->body_mass, a->nbody));
+    EXPECT_TRUE(same_bits("body_subtreemass", a->body_subtreemass, b->body_subtreemass,
+                          a->nbody));
+    EXPECT_TRUE(same_bits("body_inertia", a->body_inertia, b->body_inertia, 3 * a->nbody));
+    EXPECT_TRUE(same_bits("body_ipos", a->body_ipos, b->body_ipos, 3 * a->nbody));
+    EXPECT_TRUE(same_bits("body_iquat", a->body_iquat, b->body_iquat, 4 * a->nbody));
+    EXPECT_TRUE(same_bits("dof_invweight0", a->dof_invweight0, b->dof_invweight0, a->nv));
+    EXPECT_TRUE(same_bits("meaninertia", &a->stat.meaninertia, &b->stat.meaninertia, 1));
+    expect_same_motion(a, b, 200);  // stock MuJoCo
+  }
+  unlink(bare);
+  // gaitsim's physics (process-global callbacks: installed after the stock runs)
+  gs_physics_install();
+  for (int i = 0; i < kModels; i++) {
+    if (!with[i] || !without[i]) continue;
+    EXPECT_EQ_INT(0, gs_physics_prepare(with[i], err, sizeof(err)));
+    EXPECT_EQ_INT(0, gs_physics_prepare(without[i], err, sizeof(err)));
+    expect_same_motion(with[i], without[i], 200);
+  }
+  for (int i = 0; i < kModels; i++) {
+    if (with[i]) mj_deleteModel(with[i]);
+    if (without[i]) mj_deleteModel(without[i]);
+  }
 }
 
 // the fixture maps onto the model: stride, activations, forces, cycles
@@ -395,5 +533,6 @@ int main(void) {
   fixture_should_load_and_repeat_with_forward_translation();
   bad_solution_folders_should_name_the_file();
   png_should_round_trip();
+  display_meshes_should_change_no_physics();  // last: installs gaitsim's callbacks
   return GS_TEST_RESULT();
 }

@@ -92,10 +92,60 @@ static int missing_coordinate(const mjModel* m, const gsStateMap* map) {
   return -1;
 }
 
-// the MJCF text: include, then one key per row of t (radians) mapped by map
-static void write_mjcf(FILE* f, const mjModel* m, const char* include, const char* states_path,
-                       const gsTable* t, const gsStateMap* map, double* qpos, double* qvel,
-                       double* act) {
+// The value of attribute `name` (e.g. "meshdir") of the model file's first <compiler> element
+// into out (size n): 1 found, 0 not (no such file, element or attribute, or too long).
+static int compiler_attr(const char* model_path, const char* name, char* out, int n) {
+  FILE* f = fopen(model_path, "rb");
+  if (!f) return 0;
+  char text[8192];  // the <compiler> element sits in the file's head
+  size_t len = fread(text, 1, sizeof(text) - 1, f);
+  fclose(f);
+  text[len] = 0;
+  const char* c = strstr(text, "<compiler");
+  const char* end = c ? strchr(c, '>') : NULL;
+  if (!end) return 0;
+  char key[64];
+  snprintf(key, sizeof(key), " %s=\"", name);
+  const char* a = strstr(c, key);
+  if (!a || a > end) return 0;
+  a += strlen(key);
+  const char* q = strchr(a, '"');
+  if (!q || q > end || q - a >= n) return 0;
+  snprintf(out, (size_t)n, "%.*s", (int)(q - a), a);
+  return 1;
+}
+
+// The model's asset folders (meshdir, texturedir) relative to the exported file's folder dir, as
+// the attributes of a <compiler> element that follows the include (MuJoCo 2.2 resolves asset
+// files from the top-level file's folder, and the last <compiler> setting wins), into out (size
+// n); "" when the model names none. 0, or -1 with the reason in err.
+static int asset_dirs(const char* model_path, const char* dir, char* out, int n, char* err,
+                      int errsz) {
+  static const char* names[] = {"meshdir", "texturedir"};
+  char mdir[PATH_MAX], value[1024], target[PATH_MAX + 1100], rel[PATH_MAX];
+  folder_of(model_path, mdir, (int)sizeof(mdir));
+  out[0] = 0;
+  size_t used = 0;
+  for (int i = 0; i < 2; i++) {
+    if (!compiler_attr(model_path, names[i], value, (int)sizeof(value))) continue;
+    if (value[0] == '/') snprintf(target, sizeof(target), "%s", value);
+    else snprintf(target, sizeof(target), "%s/%s", mdir, value);
+    if (gr_keyframes_relative_path(target, dir, rel, (int)sizeof(rel), err, errsz) != 0) return -1;
+    int w = snprintf(out + used, (size_t)n - used, " %s=\"%s/\"", names[i], rel);
+    if (w < 0 || (size_t)w >= (size_t)n - used) {
+      gs_error_set(err, errsz, "%s: %s path too long", model_path, names[i]);
+      return -1;
+    }
+    used += (size_t)w;
+  }
+  return 0;
+}
+
+// the MJCF text: include, the model's asset folders seen from the exported file, then one key
+// per row of t (radians) mapped by map
+static void write_mjcf(FILE* f, const mjModel* m, const char* include, const char* assets,
+                       const char* states_path, const gsTable* t, const gsStateMap* map,
+                       double* qpos, double* qvel, double* act) {
   fputs("<!-- gaitsim export: the solved gait of ", f);
   for (const char* s = states_path; *s; s++) {
     fputc(*s == '-' && s > states_path && s[-1] == '-' ? '_' : *s, f);  // "--" ends a comment
@@ -103,7 +153,9 @@ static void write_mjcf(FILE* f, const mjModel* m, const char* include, const cha
   fputs(" as keyframes gait_000... (time s, qpos rad/m, qvel rad/s or m/s, act -). -->\n", f);
   fputs("<mujoco model=\"gaitsim export\">\n  <include file=\"", f);
   put_xml_attr(f, include);
-  fputs("\"/>\n  <keyframe>\n", f);
+  fputs("\"/>\n", f);
+  if (assets[0]) fprintf(f, "  <compiler%s/>\n", assets);
+  fputs("  <keyframe>\n", f);
   for (int r = 0; r < t->nrow; r++) {
     const double* row = t->data + (size_t)r * (size_t)t->ncol;
     for (int i = 0; i < m->nq; i++) {
@@ -177,6 +229,8 @@ int gr_keyframes_export(const mjModel* m, const char* model_path, const char* st
                                  errsz) != 0) {
     goto done;
   }
+  char assets[2 * PATH_MAX + 64];
+  if (asset_dirs(model_path, dir, assets, (int)sizeof(assets), err, errsz) != 0) goto done;
   char real_out[PATH_MAX], real_model[PATH_MAX];
   if (realpath(out_path, real_out) && realpath(model_path, real_model) &&
       strcmp(real_out, real_model) == 0) {
@@ -195,7 +249,8 @@ int gr_keyframes_export(const mjModel* m, const char* model_path, const char* st
     free(buf);
     goto done;
   }
-  write_mjcf(a.f, m, info->include, states_path, &t, &map, buf, buf + m->nq, buf + m->nq + m->nv);
+  write_mjcf(a.f, m, info->include, assets, states_path, &t, &map, buf, buf + m->nq,
+             buf + m->nq + m->nv);
   free(buf);
   if (fflush(a.f) != 0 || ferror(a.f)) {
     gs_error_set(err, errsz, "%s: %s", out_path, strerror(errno));

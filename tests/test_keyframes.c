@@ -162,9 +162,11 @@ static void missing_coordinate_should_fail_without_a_file(const char* dir) {
 }
 
 static void model_should_not_be_overwritten(const char* dir) {
-  char model[4096], err[1024], merr[1024], cmd[8400];
+  char model[4096], err[1024], merr[1024], cmd[16600];
   snprintf(model, sizeof(model), "%s/copy.xml", dir);
-  snprintf(cmd, sizeof(cmd), "cp '%s' '%s'", MODEL, model);
+  // the copy finds the model's meshes (meshdir="meshes") through a link beside it
+  snprintf(cmd, sizeof(cmd), "cp '%s' '%s' && ln -sfn \"$(dirname '%s')/meshes\" '%s/meshes'",
+           MODEL, model, MODEL, dir);
   EXPECT_EQ_INT(0, system(cmd));
   mjModel* m = mj_loadXML(model, NULL, merr, sizeof(merr));
   EXPECT_TRUE(m != NULL);

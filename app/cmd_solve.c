@@ -1297,8 +1297,9 @@ static int solve(gsTrackOptions o) {
   }
   // exact-Hessian refinement of an L-BFGS tracking solve that stopped short: Newton from the best
   // iterate with a small barrier (mu 1e-6, bound multipliers mu / s, the point barely pushed off
-  // its bounds); its result replaces the L-BFGS one only when Ipopt reaches its optimal or
-  // acceptable level, otherwise the L-BFGS best iterate stays
+  // its bounds); its result replaces the L-BFGS one when Ipopt reaches its optimal or acceptable
+  // level, and so does its best iterate when that beats the L-BFGS best iterate (the glue's
+  // ranking); otherwise the L-BFGS best iterate stays
   go_solve_result rres;
   int refined = -1;  // -1 not run, 0 run and not used, 1 used
   if (o.refine_iter > 0 && !o.hess_fd && !o.pqn && !o.ipopt.gauss_newton && res.best_iter >= 0 &&
@@ -1333,10 +1334,17 @@ static int solve(gsTrackOptions o) {
       free(lam);
       goto done;
     }
-    refined = solve_converged(&rres);
+    // used: converged, or stopped short at a best iterate that beats the L-BFGS one by the
+    // glue's ranking (among points the polish can take, the lower objective)
+    refined = solve_converged(&rres) ||
+              (rres.best_iter >= 0 &&
+               go_ipopt_point_better(rres.best_objective, rres.best_viol, res.best_objective,
+                                     res.best_viol, ro.best_viol_tol));
     fprintf(stderr, "%s: refinement: %s after %d iterations, %.1f s, objective %.6g%s\n", what,
             go_solve_status_str(rres.status), rres.iterations, rres.wall_s, rres.objective,
-            refined ? "" : "; the L-BFGS best iterate stays");
+            solve_converged(&rres) ? ""
+            : refined ? "; its best iterate beats the L-BFGS one and is kept"
+                      : "; the L-BFGS best iterate stays");
     if (refined) {
       memcpy(zb, zs, sizeof(double) * (size_t)n);
       go_solve_result merged = rres;

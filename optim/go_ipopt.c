@@ -306,13 +306,16 @@ static Bool cb_h(Index n, Number* x, Bool new_x, Number obj_factor, Index m, Num
 }
 
 // does (f, viol) beat the best so far?
-static int better(const solve_state* s, double f, double viol) {
+int go_ipopt_point_better(double f, double viol, double best_f, double best_viol, double tol) {
   if (!isfinite(f) || !isfinite(viol)) return 0;
-  if (s->best_iter < 0) return 1;
-  double tol = s->opts->best_viol_tol;
-  if (viol <= tol && s->best_viol <= tol) return f < s->best_f;
-  if (viol != s->best_viol) return viol < s->best_viol;
-  return f < s->best_f;
+  if (viol <= tol && best_viol <= tol) return f < best_f;
+  if (viol != best_viol) return viol < best_viol;
+  return f < best_f;
+}
+
+static int better(const solve_state* s, double f, double viol) {
+  if (s->best_iter < 0) return isfinite(f) && isfinite(viol);
+  return go_ipopt_point_better(f, viol, s->best_f, s->best_viol, s->opts->best_viol_tol);
 }
 
 // score the scaled point x (n) as iterate iter; uses cached g/f when they belong to x

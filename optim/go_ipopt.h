@@ -144,4 +144,8 @@ int go_ipopt_stop_signals(void);
 // Register (pid > 0) or drop a child process that stop signals are passed on to (at most 8).
 void go_ipopt_forward_signals_to(long pid, int add);
 
+// The best-iterate ranking (above): 1 when the point (objective f, max scaled violation viol)
+// beats the best one so far (best_f, best_viol), with tol the best_viol_tol of the solve.
+int go_ipopt_point_better(double f, double viol, double best_f, double best_viol, double tol);
+
 #endif  // GAITSIM_OPTIM_GO_IPOPT_H_

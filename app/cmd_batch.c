@@ -20,9 +20,10 @@ static const char* kBatchUsage =
     "a named solve's result, sweeps (their speeds in order, each from the one before), with the\n"
     "options of gaitsim track / predict. The plan is checked whole first (trial and guess folders,\n"
     "every option, dependencies, cycles); on an error nothing runs. Each solve runs `gaitsim\n"
-    "track` or `gaitsim predict` into DIR/NAME/ (its progress in DIR/NAME/log.txt, its exit\n"
-    "status and wall time in DIR/NAME/batch.json). Running a plan again on the same DIR keeps the\n"
-    "solves that ended (exit 0 or 3) with unchanged options and inputs and redoes the rest.\n"
+    "track` or `gaitsim predict` into its solution folder DIR/NAME/ (its progress in\n"
+    "DIR/logs/NAME.log, its exit status and wall time in DIR/logs/NAME.json). Running a plan\n"
+    "again on the same DIR keeps the solves that ended (exit 0 or 3) with unchanged options and\n"
+    "inputs and redoes the rest.\n"
     "DIR/batch.csv and DIR/batch.md: one row per solve (status, wall time, stride time, cost of\n"
     "transport, Table 1 RMS errors of tracks).\n\n"
     "  --local N   run here, at most N solves at once (default 1), each after the solves it\n"
@@ -38,7 +39,7 @@ static const char* kBatchUsage =
 static const char* kStatusUsage =
     "usage: gaitsim batch-status DIR [--wait]\n\n"
     "The state of each solve of the batch in DIR: done, stopped short, failed, interrupted (from\n"
-    "DIR/NAME/batch.json), pending or running (squeue, for a batch submitted with --slurm),\n"
+    "DIR/logs/NAME.json), pending or running (squeue, for a batch submitted with --slurm),\n"
     "skipped (a solve it depends on failed) or not run; rewrites DIR/batch.csv and batch.md.\n\n"
     "  --wait      poll every 5 s until no solve is pending or running\n";
 

@@ -365,8 +365,13 @@ static int topological(gsBatchPlan* p) {
   return 0;
 }
 
+// a solve name: letters, digits, '_', '-', '.', not starting with '.', and not one of the
+// batch's own entries in DIR
 static int valid_name(const char* s) {
+  static const char* taken[] = {"logs", "slurm", "plan.json", "batch.csv", "batch.md"};
   if (!*s || strlen(s) >= GS_BATCH_NAME_MAX - 16 || s[0] == '.') return 0;
+  for (size_t k = 0; k < sizeof(taken) / sizeof(taken[0]); k++)
+    if (strcmp(s, taken[k]) == 0) return 0;
   for (const char* c = s; *c; c++)
     if (!((*c >= 'a' && *c <= 'z') || (*c >= 'A' && *c <= 'Z') || (*c >= '0' && *c <= '9') ||
           *c == '_' || *c == '-' || *c == '.'))
@@ -492,7 +497,8 @@ static int load(gsBatchPlan* p, const cJSON* root, char* err, int errsz) {
     const cJSON* nm = cJSON_GetObjectItemCaseSensitive(e, "name");
     if (!cJSON_IsObject(e) || !cJSON_IsString(nm) || !valid_name(nm->valuestring)) {
       gs_error_set(err, errsz, "solves[%d].name: a name of letters, digits, '_', '-', '.' "
-                   "expected (it names the solve's folder)", idx);
+                   "expected (it names the solve's folder; not logs, slurm, plan.json, "
+                   "batch.csv, batch.md)", idx);
       return -1;
     }
     const cJSON* tr = cJSON_GetObjectItemCaseSensitive(e, "track");

@@ -41,10 +41,14 @@ static double now_s(void) {
   return (double)t.tv_sec + 1e-9 * (double)t.tv_nsec;
 }
 
+void gs_batch_file(char* path, size_t n, const char* dir, const char* name, const char* what) {
+  snprintf(path, n, "%s/logs/%s.%s", dir, name, what);
+}
+
 void gs_batch_record_read(const char* dir, const char* name, gsBatchRecord* r) {
   char path[2 * GS_BATCH_PATH_MAX];
   memset(r, 0, sizeof(*r));
-  snprintf(path, sizeof(path), "%s/%s/batch.json", dir, name);
+  gs_batch_file(path, sizeof(path), dir, name, "json");
   cJSON* j = gs_app_read_json(path);
   const cJSON* ex = cJSON_GetObjectItemCaseSensitive(j, "exit");
   const cJSON* fp = cJSON_GetObjectItemCaseSensitive(j, "fingerprint");
@@ -103,7 +107,7 @@ void gs_batch_complete(const gsBatchPlan* plan, const char* dir, char* complete)
   }
 }
 
-// write DIR/NAME/batch.json for a child that ended with status st after wall seconds
+// write DIR/logs/NAME.json for a child that ended with status st after wall seconds
 static void write_record(const gsBatchPlan* plan, int i, const char* dir, const char* exe,
                          unsigned long long fp, int st, double wall, int interrupted) {
   int code = WIFEXITED(st) ? WEXITSTATUS(st) : WIFSIGNALED(st) ? 128 + WTERMSIG(st) : 255;
@@ -121,23 +125,24 @@ static void write_record(const gsBatchPlan* plan, int i, const char* dir, const 
   gs_batch_argv_free(a);
   char* text = cJSON_Print(j);
   cJSON_Delete(j);
-  snprintf(path, sizeof(path), "%s/%s/batch.json", dir, plan->solve[i].name);
+  gs_batch_file(path, sizeof(path), dir, plan->solve[i].name, "json");
   if (!text || gs_atomic_write_buffer(path, text, strlen(text), err, sizeof(err)) != 0)
     fprintf(stderr, "gaitsim: %s\n", text ? err : "out of memory");
   free(text);
 }
 
-// start solve i: its folder (its old record removed), log.txt, the child in its own process
-// group (so that a terminal's Ctrl-C reaches it only through the batch) ignoring SIGTERM; its
-// pid, or -1 and err
+// start solve i: DIR/logs (its old record removed), its log DIR/logs/NAME.log, the child in its
+// own process group (so that a terminal's Ctrl-C reaches it only through the batch); its pid, or
+// -1 and err. DIR/NAME itself is left to the child (a solve refuses a folder holding anything but
+// an earlier result)
 static pid_t start(const gsBatchPlan* plan, int i, const char* dir, const char* exe, char* err,
                    int errsz) {
   char path[2 * GS_BATCH_PATH_MAX + 16];
-  snprintf(path, sizeof(path), "%s/%s", dir, plan->solve[i].name);
+  snprintf(path, sizeof(path), "%s/logs", dir);
   if (gs_mkdir_p(path, err, errsz) != 0) return -1;
-  snprintf(path, sizeof(path), "%s/%s/batch.json", dir, plan->solve[i].name);
+  gs_batch_file(path, sizeof(path), dir, plan->solve[i].name, "json");
   unlink(path);
-  snprintf(path, sizeof(path), "%s/%s/log.txt", dir, plan->solve[i].name);
+  gs_batch_file(path, sizeof(path), dir, plan->solve[i].name, "log");
   char** argv = gs_batch_argv(plan, i, exe, dir);
   int fd = open(path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
   if (!argv || fd < 0) {
@@ -154,11 +159,10 @@ static pid_t start(const gsBatchPlan* plan, int i, const char* dir, const char* 
     dup2(fd, 1);
     dup2(fd, 2);
     close(fd);
-    // SIGINT stops the solve with its best iterate; SIGTERM is ignored (kept across exec), as
-    // the batch turns its own SIGTERM into a SIGINT: Slurm's scancel and time limit signal every
-    // process of a job, and the solve must not die before it has written its result
+    // the solve installs its own stop signals (go_ipopt_install_stop_signals); until then the
+    // defaults, not the batch's handlers
     signal(SIGINT, SIG_DFL);
-    signal(SIGTERM, SIG_IGN);
+    signal(SIGTERM, SIG_DFL);
     execv(exe, argv);
     fprintf(stderr, "gaitsim: %s: %s\n", exe, strerror(errno));
     _exit(127);
@@ -171,9 +175,12 @@ static pid_t start(const gsBatchPlan* plan, int i, const char* dir, const char* 
 }
 
 // run the solves in state RUN_WAIT, at most nmax at once, each after its dependencies ended
-// (RUN_ENDED or RUN_KEPT); the exit status of gs_batch_run_local
+// (RUN_ENDED or RUN_KEPT); the exit status of gs_batch_run_local. A stop signal to the batch
+// passes one SIGINT to each running solve, except a SIGTERM when term_reaches_solves (a Slurm
+// job: scancel and the time limit send SIGTERM to every process of the job, the solve too), so
+// that a solve receives one stop signal either way
 static int run(const gsBatchPlan* plan, const char* dir, const char* exe, int nmax,
-               runState* state, char* err, int errsz) {
+               int term_reaches_solves, runState* state, char* err, int errsz) {
   int n = plan->nsolve, going = 0, rc = GS_EXIT_OK;
   pid_t* pid = (pid_t*)calloc((size_t)n, sizeof(pid_t));
   double* t0 = (double*)calloc((size_t)n, sizeof(double));
@@ -225,10 +232,10 @@ static int run(const gsBatchPlan* plan, const char* dir, const char* exe, int nm
       fflush(stdout);
     }
     if (going == 0) break;
-    if (g_stop) {  // ask every running solve to stop with its best iterate
+    if (g_stop) {  // ask every running solve, once, to stop with its best iterate
       for (int i = 0; i < n; i++)
         if (state[i] == RUN_GOING && !stopped[i]) {
-          kill(pid[i], SIGINT);
+          if (!(term_reaches_solves && g_stop == SIGTERM)) kill(pid[i], SIGINT);
           stopped[i] = 1;
         }
     }
@@ -289,7 +296,7 @@ int gs_batch_run_local(const gsBatchPlan* plan, const char* dir, const char* exe
     kept += complete[i];
   }
   printf("batch: %d solves, %d kept from an earlier run, at most %d at once\n", n, kept, nmax);
-  int rc = run(plan, dir, exe, nmax, state, err, errsz);
+  int rc = run(plan, dir, exe, nmax, 0, state, err, errsz);
   const char** word = (const char**)calloc((size_t)n, sizeof(char*));
   for (int i = 0; word && i < n; i++)
     word[i] = state[i] == RUN_SKIPPED ? "skipped" : state[i] == RUN_WAIT ? "not run" : NULL;
@@ -311,7 +318,7 @@ int gs_batch_run_one(const gsBatchPlan* plan, const char* dir, const char* exe, 
     return GS_EXIT_FAILURE;
   }
   for (int k = 0; k < plan->nsolve; k++) state[k] = k == i ? RUN_WAIT : RUN_KEPT;
-  int rc = run(plan, dir, exe, 1, state, err, errsz);
+  int rc = run(plan, dir, exe, 1, 1, state, err, errsz);
   free(state);
   // the table as far as the batch has come (the other jobs rewrite it as they end)
   char cerr[512];

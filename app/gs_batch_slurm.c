@@ -187,7 +187,7 @@ int gs_batch_slurm_submit(const gsBatchPlan* plan, const char* dir, const char* 
     kept += complete[i];
     if (complete[i]) continue;
     cJSON_DeleteItemFromObjectCaseSensitive(jobs, plan->solve[i].name);
-    snprintf(path, sizeof(path), "%s/%s/batch.json", dir, plan->solve[i].name);
+    gs_batch_file(path, sizeof(path), dir, plan->solve[i].name, "json");
     unlink(path);  // an old record would read as this run's result
   }
   printf("batch: %d solves, %d kept from an earlier run, %d to submit\n", n, kept, n - kept);

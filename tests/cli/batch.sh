@@ -4,13 +4,14 @@
 # from the one before, 3 iterations each), a track made to fail (a broken model) and a prediction
 # from it. With --local 2: the two tracks run at once and never more than two solves; exit 1
 # (one failed); the failure's dependant skipped, the rest stopped short at their limits (exit 3);
-# each solve's record and log; the sweep's speeds continue from each other and hold their speed
+# each solve's record and log (out/logs/NAME.json, NAME.log; the solution folder holds the
+# result only, the failure none); the sweep's speeds continue from each other and hold their speed
 # (to the violation left); batch.csv with one row per solve, the records' wall times and the
 # tracks' RMS errors. The same plan again keeps the five that ended and redoes only the failure;
 # a changed sweep option redoes the sweep and keeps the tracks. batch-status reads the folders.
-# SIGTERM stops a running solve cleanly: exit 3, the record says interrupted, the best iterate is
-# written, and the next run redoes it. Plan errors (unknown dependency, cycle, bad option,
-# unknown trial) exit 1 with one line naming the field and create nothing.
+# SIGTERM to the batch stops a running solve cleanly (the batch sends it one SIGINT): exit 3, the
+# record says interrupted, the best iterate is written, and the next run redoes it. Plan errors (unknown dependency, cycle, bad option,
+# a name the batch uses itself, unknown trial) exit 1 with one line naming the field and create nothing.
 # usage: batch.sh GAITSIM SOURCE_DIR
 set -u
 gaitsim=$1 src=$2
@@ -60,8 +61,8 @@ d = sys.argv[1]
 want = {"t1": 3, "t2": 3, "up_1.2": 3, "up_1.4": 3, "up_1.6": 3, "bad": 1}
 ok = True
 for n, code in want.items():
-    r = json.load(open(f"{d}/{n}/batch.json"))
-    log = open(f"{d}/{n}/log.txt").read()
+    r = json.load(open(f"{d}/logs/{n}.json"))
+    log = open(f"{d}/logs/{n}.log").read()
     ok &= r["exit"] == code and not r["interrupted"] and 0 < r["wall_s"] < 120
     ok &= ("iter" in log) if code == 3 else ("bad.xml" in log)
     if not ok:
@@ -69,12 +70,16 @@ for n, code in want.items():
 sys.exit(0 if ok else 1)
 PY
 check "the skipped solve has no folder" test ! -e out/after_bad
+check "the failed solve left no folder (a solve writes its folder whole or not at all)" \
+  test ! -e out/bad
+check "a solution folder holds the solve's result only (its log and record in out/logs)" \
+  test "$(ls out/t1 | grep -c -e summary.json -e log.txt -e batch.json)" -eq 1 -a -f out/t1/summary.json
 check "sweep: each speed from the one before, holding its speed" /usr/bin/python3 - out <<'PY'
 import json, os, sys
 d = os.path.realpath(sys.argv[1])
 ok = True
 for v, g in (("1.2", "t1"), ("1.4", "up_1.2"), ("1.6", "up_1.4")):
-    cmd = json.load(open(f"{d}/up_{v}/batch.json"))["command"]
+    cmd = json.load(open(f"{d}/logs/up_{v}.json"))["command"]
     s = json.load(open(f"{d}/up_{v}/summary.json"))
     ok &= cmd[cmd.index("--guess") + 1] == f"{d}/{g}" and cmd[cmd.index("--speed") + 1] == v
     ok &= abs(s["speed_mps"] - float(v)) <= max(1e-4, s["max_violation"])
@@ -90,7 +95,7 @@ want = {"t1": "stopped short", "t2": "stopped short", "up_1.2": "stopped short",
         "after_bad": "skipped"}
 ok = {n: r["status"] for n, r in rows.items()} == want
 for n in ("t1", "t2", "up_1.2"):
-    r, rec = rows[n], json.load(open(f"{d}/{n}/batch.json"))
+    r, rec = rows[n], json.load(open(f"{d}/logs/{n}.json"))
     s = json.load(open(f"{d}/{n}/summary.json"))
     ok &= abs(float(r["wall_s"]) - rec["wall_s"]) <= 0.05
     ok &= abs(float(r["stride_time_s"]) - s["stride_time_s"]) <= 1e-4
@@ -106,20 +111,20 @@ PY
 check "batch.md: a row per solve" test "$(grep -c '^| [a-z]' out/batch.md)" -eq 8
 
 # the same plan again: the five that ended are kept, the failure is tried again
-cp out/t1/batch.json t1_record.json
+cp out/logs/t1.json t1_record.json
 "$gaitsim" batch plan.json --out out --local 2 >run2.txt 2>&1
 status=$?
 check "again: exit 1 (got $status)" test "$status" -eq 1
 check "again: five kept" grep -q '^batch: 7 solves, 5 kept from an earlier run' run2.txt
 check "again: only bad started" test "$(grep -c ': started' run2.txt)" -eq 1
-check "again: t1's record untouched" cmp -s t1_record.json out/t1/batch.json
+check "again: t1's record untouched" cmp -s t1_record.json out/logs/t1.json
 # a changed sweep option: the sweep is redone, the tracks kept
 plan 2
 "$gaitsim" batch plan.json --out out --local 2 >run3.txt 2>&1
 check "sweep changed: its three speeds and bad redone, the tracks kept" \
   test "$(grep ': started' run3.txt | cut -d: -f2 | tr -d ' ' | sort | tr '\n' ' ')" = \
   "bad up_1.2 up_1.4 up_1.6 "
-check "sweep changed: the new iteration limit" grep -q '"2"' out/up_1.6/batch.json
+check "sweep changed: the new iteration limit" grep -q '"2"' out/logs/up_1.6.json
 "$gaitsim" batch-status out >status.txt 2>&1
 check "batch-status: statuses" test "$(awk '{print $1 ":" $2}' status.txt | tr '\n' ' ')" = \
   "t1:stopped t2:stopped up_1.2:stopped up_1.4:stopped up_1.6:stopped bad:failed after_bad:skipped "
@@ -132,20 +137,22 @@ cat >long.json <<EOF
 EOF
 "$gaitsim" batch long.json --out lo --local 1 >run4.txt 2>&1 &
 pid=$!
-for _ in $(seq 300); do grep -q '^iter' lo/long/log.txt 2>/dev/null && break; sleep 0.1; done
+for _ in $(seq 300); do grep -q '^iter' lo/logs/long.log 2>/dev/null && break; sleep 0.1; done
 kill -TERM "$pid"
 wait "$pid"
 status=$?
 check "SIGTERM: exit 3 (got $status)" test "$status" -eq 3
 check "SIGTERM: the solve interrupted with its best iterate written" /usr/bin/python3 - lo/long <<'PY'
 import json, sys
-r = json.load(open(sys.argv[1] + "/batch.json"))
+r = json.load(open(sys.argv[1] + "/../logs/long.json"))
 s = json.load(open(sys.argv[1] + "/summary.json"))
 ok = r["interrupted"] and r["exit"] == 3 and r["wall_s"] < 60 and s["iterations"] < 5000
 if not ok:
     print(r, s.get("iterations"), file=sys.stderr)
 sys.exit(0 if ok else 1)
 PY
+n=$(grep -c 'stop signal' lo/logs/long.log)
+check "SIGTERM: one stop signal reached the solve (got $n)" test "$n" -eq 1
 "$gaitsim" batch long.json --out lo --local 1 >run5.txt 2>&1 &
 pid=$!
 for _ in $(seq 300); do grep -q 'started' run5.txt && break; sleep 0.1; done
@@ -172,6 +179,8 @@ bad_plan "bad option" 'solves[0].options.nodes: an integer >= 3 and <= 1000000 e
   "{\"name\": \"a\", \"track\": \"$trial\", \"options\": {\"nodes\": 2}}"
 bad_plan "option of the other command" 'solves[0].options.refine: not an option of gaitsim predict' \
   "{\"name\": \"a\", \"predict\": 1.2, \"guess\": \"$PWD/out/t1\", \"options\": {\"refine\": 2}}"
+bad_plan "a name the batch uses itself" "solves[0].name: a name of letters, digits, '_', '-', '.' expected (it names the solve's folder; not logs, slurm, plan.json, batch.csv, batch.md)" \
+  "{\"name\": \"logs\", \"track\": \"$trial\"}"
 bad_plan "unknown trial" 'solves[0].track: no trial folder (coordinates.mot, grf.mot) "nowhere"' \
   '{"name": "a", "track": "nowhere"}'
 # the plan's option table follows the commands: every option in `gaitsim track --help` and

@@ -10,8 +10,9 @@
 # (cancelled by Slurm, never run) while the independent ones went on; batch.csv agrees. The same
 # plan submitted again submits only the failure and its dependant (the five that ended are kept,
 # their records untouched). A long solve: submitting it again while it is queued is refused, and
-# scancel stops it with its best iterate written (status interrupted). Every daemon it started is
-# stopped at the end.
+# scancel stops it with its best iterate written (status interrupted), the solve receiving one
+# stop signal (Slurm's SIGTERM; the job's batch process does not pass it on). Every daemon it
+# started is stopped at the end.
 # When Slurm is not installed or cannot start here, the test says so on stderr, leaves
 # BUILD_DIR/slurm_skipped.txt with the reason (scripts/test.sh prints it) and exits 77 (CTest:
 # skipped). Label: slurm.
@@ -141,7 +142,7 @@ status=$?
 check "batch-status --wait: exit 0 (got $status)" test "$status" -eq 0
 check "statuses" test "$(awk '{print $1 ":" $2}' status1.txt | tr '\n' ' ')" = \
   "t1:stopped t2:stopped up_1.2:stopped up_1.4:stopped up_1.6:stopped bad:failed after_bad:skipped "
-check "the skipped solve never ran" test ! -e "$out/after_bad/batch.json"
+check "the skipped solve never ran" test ! -e "$out/logs/after_bad.json"
 check "batch.csv: records of the five that ended, the failure, the skipped one" \
   /usr/bin/python3 - "$out" <<'PY'
 import csv, json, sys
@@ -149,7 +150,7 @@ d = sys.argv[1]
 rows = {r["solve"]: r for r in csv.DictReader(open(f"{d}/batch.csv"))}
 ok = rows["bad"]["status"] == "failed" and rows["after_bad"]["status"] == "skipped"
 for n in ("t1", "t2", "up_1.2", "up_1.4", "up_1.6"):
-    rec = json.load(open(f"{d}/{n}/batch.json"))
+    rec = json.load(open(f"{d}/logs/{n}.json"))
     s = json.load(open(f"{d}/{n}/summary.json"))
     ok &= rows[n]["status"] == "stopped short" and rec["exit"] == 3
     ok &= abs(float(rows[n]["wall_s"]) - rec["wall_s"]) <= 0.05
@@ -162,14 +163,14 @@ sys.exit(0 if ok else 1)
 PY
 
 # the same plan again: only the failure and its dependant are submitted
-cp "$out/t1/batch.json" t1_record.json
+cp "$out/logs/t1.json" t1_record.json
 "$gaitsim" batch plan.json --out "$out" --slurm >submit2.txt 2>&1
 status=$?
 check "again: exit 0 (got $status)" test "$status" -eq 0
 check "again: five kept, two submitted" grep -q '^batch: 7 solves, 5 kept from an earlier run, 2 to submit' submit2.txt
 timeout 120 "$gaitsim" batch-status "$out" --wait >status2.txt 2>&1
 check "again: the same statuses" cmp -s status1.txt status2.txt
-check "again: t1 not redone" cmp -s t1_record.json "$out/t1/batch.json"
+check "again: t1 not redone" cmp -s t1_record.json "$out/logs/t1.json"
 
 # a long solve: a second submission while it is queued is refused; scancel (SIGTERM to every
 # process of the job) stops it with its best iterate written
@@ -184,19 +185,21 @@ err=$("$gaitsim" batch long.json --out "$work/lo" --slurm 2>&1 >/dev/null)
 status=$?
 check "long: a second submission while queued: exit 1 (got $status)" test "$status" -eq 1
 check "long: one line naming the queued solve" grep -q '^gaitsim: long.json: 1 solves of an earlier submission are still queued or running (long)' <<<"$err"
-for _ in $(seq 600); do grep -q '^iter' "$work/lo/long/log.txt" 2>/dev/null && break; sleep 0.1; done
+for _ in $(seq 600); do grep -q '^iter' "$work/lo/logs/long.log" 2>/dev/null && break; sleep 0.1; done
 scancel "$(/usr/bin/python3 -c 'import json,sys; print(json.load(open(sys.argv[1]))["long"])' "$work/lo/slurm/jobs.json")"
 timeout 120 "$gaitsim" batch-status "$work/lo" --wait >status3.txt 2>&1
 check "long: scancel: interrupted" test "$(awk '{print $2}' status3.txt)" = interrupted
 check "long: scancel: the best iterate written" /usr/bin/python3 - "$work/lo/long" <<'PY'
 import json, sys
-r = json.load(open(sys.argv[1] + "/batch.json"))
+r = json.load(open(sys.argv[1] + "/../logs/long.json"))
 s = json.load(open(sys.argv[1] + "/summary.json"))
 ok = r["interrupted"] and r["exit"] == 3 and s["iterations"] < 5000
 if not ok:
     print(r, s.get("iterations"), file=sys.stderr)
 sys.exit(0 if ok else 1)
 PY
+n=$(grep -c 'stop signal' "$work/lo/logs/long.log")
+check "long: scancel: one stop signal reached the solve (got $n)" test "$n" -eq 1
 
 stop_daemons
 gone() { local p; for p in "${pids[@]}"; do if kill -0 "$p" 2>/dev/null; then return 1; fi; done; }

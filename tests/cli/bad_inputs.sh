@@ -141,6 +141,7 @@ sed -i '/^time\t/s/\thip_flexion\t/\thip_flexion_x\t/' renamed/coordinates.mot
 expect "trial with a renamed coordinate column" 1 \
   '^gaitsim: renamed/coordinates\.mot: no column for 1 of the model.s 9 coordinates: hip_flexion$' keep \
   "$G" track renamed --model "$planar" --out keep --threads 1 --nodes 6 --max-iter 1
+ln -sfn "$src/mjmodels/meshes" meshes  # the copies below find the model's bone meshes
 sed 's/angle="radian"/angle="degree"/' "$planar" >degree.xml
 expect "model in degrees" 1 '^gaitsim: degree\.xml: angles must be in radians.*says degree' keep \
   "$G" track "$trial" --model degree.xml --out keep --threads 1 --nodes 6 --max-iter 1

@@ -7,6 +7,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <errno.h>
+#include <unistd.h>
 
 #include "app/gs_app_model.h"
 #include "app/gs_commands.h"
@@ -15,12 +17,12 @@
 #include "optim/go_ipopt.h"
 
 static const char* kRunUsage =
-    "usage: gaitsim run [--out DIR] [--nodes N] [--threads N] [--max-iter N] [--max-time S]\n"
-    "                   [--speeds LIST]\n"
+    "usage: gaitsim run [--out DIR] [--trial DIR] [--nodes N] [--threads N] [--max-iter N]\n"
+    "                   [--max-time S] [--speeds LIST]\n"
     "                   [--no-video]\n\n"
     "The default job on the bundled model and trial (mjmodels/jw_fullbody_knee6.xml, the\n"
-    "six-DOF implant knee with surrogate contact,\n"
-    "mjmodels/trials/jw_ngait_og5):\n"
+    "six-DOF implant knee with surrogate contact, and mjmodels/trials/jw_ngait_og5, or the\n"
+    "trial folder of --trial, e.g. mjmodels/trials/jw_bouncy7):\n"
     "  1. DIR/track: tracking solve on N nodes (default 20; more nodes are solved on 20 first and\n"
     "     continued): up to 600 L-BFGS iterations; if they stop short, up to 150 Newton\n"
     "     iterations with the exact Hessian (gaitsim track --refine); polished to a dynamically\n"
@@ -35,6 +37,8 @@ static const char* kRunUsage =
     "  4. DIR/*/gait.mp4 and strip.png: video (3 strides) and filmstrip of every solution.\n"
     "Results in DIR (default results/). Exit status 0 when every solve converged, 3 when one\n"
     "stopped short (its best iterate written), else as the failing step.\n\n"
+    "  --trial DIR    the trial folder to track (coordinates.mot, grf.mot, knee_contact.sto;\n"
+    "                 scripts/prepare_trial.py makes one; default mjmodels/trials/jw_ngait_og5)\n"
     "  --max-iter N   Ipopt iteration limit of each predictive solve (default 1500: an iteration\n"
     "                 budget, not a time limit, so that the results do not depend on the load\n"
     "                 of the machine; in the measured main jobs (docs/BENCHMARKS.md) they\n"
@@ -82,19 +86,22 @@ int gs_cmd_run(int argc, char** argv) {
       {"threads", required_argument, NULL, 't'},  {"max-time", required_argument, NULL, 'T'},
       {"max-iter", required_argument, NULL, 'i'},
       {"speeds", required_argument, NULL, 's'},   {"no-video", no_argument, NULL, 'V'},
-      {"help", no_argument, NULL, 'h'},           {NULL, 0, NULL, 0}};
+      {"trial", required_argument, NULL, 'r'},    {"help", no_argument, NULL, 'h'},
+      {NULL, 0, NULL, 0}};
   const char *out = "results", *nodes = "20", *threads = "2", *max_time = NULL;
   const char* max_iter = "1500";
   char speeds[256] = "0.8,2.0";
   int video = 1;
+  const char* trial = GAITSIM_SOURCE_DIR "/mjmodels/trials/jw_ngait_og5";
   optind = 1;
   opterr = 0;
   int c, bad = 0, k;
   double v[GS_MAX_SPEEDS];
   // every value the steps are given is checked here, before the first solve
-  while (!bad && (c = getopt_long(argc, argv, ":o:n:t:T:i:s:Vh", options, NULL)) != -1) {
+  while (!bad && (c = getopt_long(argc, argv, ":o:r:n:t:T:i:s:Vh", options, NULL)) != -1) {
     switch (c) {
       case 'o': out = optarg; break;
+      case 'r': trial = optarg; break;
       case 'n': bad = gs_opt_solve_limit(c, optarg, &nodes); break;
       case 'T': bad = gs_opt_solve_limit(c, optarg, &max_time); break;
       case 'i': bad = gs_opt_solve_limit(c, optarg, &max_iter); break;
@@ -116,6 +123,16 @@ int gs_cmd_run(int argc, char** argv) {
   }
   if (bad) return GS_EXIT_USAGE;
   if (optind != argc) return gs_opt_usage_error("run", "unexpected argument '%s'", argv[optind]);
+  // the trial folder holds what the tracking solve reads
+  static const char* trial_files[] = {"coordinates.mot", "grf.mot"};
+  for (int i = 0; i < 2; i++) {
+    char path[4200];
+    snprintf(path, sizeof(path), "%s/%s", trial, trial_files[i]);
+    if (access(path, R_OK) != 0) {
+      fprintf(stderr, "gaitsim: --trial: %s: %s\n", path, strerror(errno));
+      return GS_EXIT_USAGE;
+    }
+  }
   // the solution folders it replaces must be earlier results (summary.json) or absent
   char err[1024], sub_dir[4200];
   for (int i = 0; i < 2; i++) {
@@ -126,7 +143,6 @@ int gs_cmd_run(int argc, char** argv) {
     }
   }
   go_ipopt_install_stop_signals(gs_folder_abort_from_signal);
-  const char* trial = GAITSIM_SOURCE_DIR "/mjmodels/trials/jw_ngait_og5";
   char coarse[4096], track[4096];
   snprintf(coarse, sizeof(coarse), "%s/track_n20", out);
   snprintf(track, sizeof(track), "%s/track", out);

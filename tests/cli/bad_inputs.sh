@@ -111,6 +111,8 @@ check "run --nodes 0: rejected at once ($(( $(date +%s) - start )) s)" test $(( 
 expect "run --threads 0" 2 '^gaitsim: --threads: .*\(got 0\)$' keep "$G" run --out keep --threads 0
 expect "run --speeds abc" 2 '^gaitsim: --speeds: .*\(got abc\)$' keep "$G" run --out keep --speeds abc
 expect "run --max-time -1" 2 '^gaitsim: --max-time: .*\(got -1\)$' keep "$G" run --out keep --max-time -1
+expect "run --trial without a trial" 2 '^gaitsim: --trial: nowhere/coordinates.mot: No such file or directory$' keep \
+  "$G" run --out keep --trial nowhere
 S=(simulate "$planar" --out keep)
 expect "simulate --duration 1e12" 2 '^gaitsim: --duration: must be a number in \(0, 3600\] \(got 1e12\)$' \
   keep "$G" "${S[@]}" --duration 1e12

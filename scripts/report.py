@@ -357,12 +357,18 @@ def load(args):
     return d
 
 
-def panel_style(ax, xlabel, ylabel):
-    ax.set_xlim(0, 100)
+def axes_style(ax, xlabel, ylabel):
+    """Axis labels, small ticks and a light grid."""
     ax.set_xlabel(xlabel, fontsize=7)
     ax.set_ylabel(ylabel, fontsize=7)
     ax.tick_params(labelsize=6)
     ax.grid(alpha=0.3, linewidth=0.5)
+
+
+def panel_style(ax, xlabel, ylabel):
+    """A panel over % gait cycle (0..100)."""
+    ax.set_xlim(0, 100)
+    axes_style(ax, xlabel, ylabel)
 
 
 def png_bytes(fig, plt):
@@ -618,11 +624,10 @@ def is_sweep_dir(args):
     return False
 
 
-def read_sweep_csv(path):
-    """(header, rows): rows as dicts of the raw strings plus "_speed" and, for SWEEP_REQUIRED,
-    floats ("nan" allowed: a failed solve); sorted by speed. PrepError on a missing file, a
-    missing required column, a row of the wrong length, a non-numeric required value, a speed
-    that is not a positive number or repeated, or no rows."""
+def read_csv_rows(path, required):
+    """(header, [(line number, row)]): a CSV file's header and its non-blank rows as dicts of the
+    stripped strings. PrepError on a missing or unreadable file, no header, a missing required
+    column or a row of the wrong length."""
     import csv
     try:
         with open(path, encoding="utf-8", newline="") as f:
@@ -634,14 +639,25 @@ def read_sweep_csv(path):
     if not lines:
         raise PrepError(path, "empty (no header line)")
     header = [h.strip() for h in lines[0][1]]
-    missing = [c for c in SWEEP_REQUIRED if c not in header]
+    missing = [c for c in required if c not in header]
     if missing:
         raise PrepError(path, "missing column(s) " + ", ".join(missing))
     rows = []
     for lineno, fields in lines[1:]:
         if len(fields) != len(header):
             raise PrepError(path, f"line {lineno}: {len(fields)} fields, header has {len(header)}")
-        r = {h: x.strip() for h, x in zip(header, fields)}
+        rows.append((lineno, {h: x.strip() for h, x in zip(header, fields)}))
+    return header, rows
+
+
+def read_sweep_csv(path):
+    """(header, rows): rows as dicts of the raw strings plus "_speed" and, for SWEEP_REQUIRED,
+    floats ("nan" allowed: a failed solve); sorted by speed. PrepError on a missing file, a
+    missing required column, a row of the wrong length, a non-numeric required value, a speed
+    that is not a positive number or repeated, or no rows."""
+    header, lines = read_csv_rows(path, SWEEP_REQUIRED)
+    rows = []
+    for lineno, r in lines:
         for c in SWEEP_REQUIRED:
             try:
                 r["_" + c] = float(r[c])
@@ -900,10 +916,7 @@ def fig_sweep_gait(d, plt):
                 ax.plot([tv], [ty], linestyle="none", marker="x", markersize=7, color="black",
                         label="tracking solution")
         ax.set_title(title, fontsize=8)
-        ax.set_xlabel("speed (m/s)", fontsize=7)
-        ax.set_ylabel(unit, fontsize=7)
-        ax.tick_params(labelsize=6)
-        ax.grid(alpha=0.3, linewidth=0.5)
+        axes_style(ax, "speed (m/s)", unit)
         ax.legend(fontsize=6, loc="best")
     fig.suptitle("Stride time, stride length and cost of transport against speed (sweep.csv)",
                  fontsize=9)
@@ -1016,26 +1029,10 @@ def read_batch_csv(path):
     cell) for BATCH_NUMERIC and the rms_* columns, in file order. PrepError on a missing file, a
     missing required column, a row of the wrong length, a non-numeric number, a repeated solve or
     no rows."""
-    import csv
-    try:
-        with open(path, encoding="utf-8", newline="") as f:
-            lines = [(n, r) for n, r in enumerate(csv.reader(f), 1) if any(x.strip() for x in r)]
-    except FileNotFoundError:
-        raise PrepError(path, "file not found")
-    except (OSError, UnicodeDecodeError, csv.Error) as e:
-        raise PrepError(path, getattr(e, "strerror", None) or str(e) or "cannot read")
-    if not lines:
-        raise PrepError(path, "empty (no header line)")
-    header = [h.strip() for h in lines[0][1]]
-    missing = [c for c in BATCH_REQUIRED if c not in header]
-    if missing:
-        raise PrepError(path, "missing column(s) " + ", ".join(missing))
+    header, lines = read_csv_rows(path, BATCH_REQUIRED)
     numeric = [c for c in header if c in BATCH_NUMERIC or c.startswith("rms_")]
     rows = []
-    for lineno, fields in lines[1:]:
-        if len(fields) != len(header):
-            raise PrepError(path, f"line {lineno}: {len(fields)} fields, header has {len(header)}")
-        r = {h: x.strip() for h, x in zip(header, fields)}
+    for lineno, r in lines:
         for c in numeric:
             try:
                 r["_" + c] = float(r[c]) if r[c] else float("nan")
@@ -1128,10 +1125,7 @@ def fig_batch_speed(d, plt):
             ax.plot(*zip(*PAPER_STRIDE_TIME), linestyle="none", marker="*", markersize=10,
                     color="tab:red", label="Lin et al. 2018, predicted")
         ax.set_title(title, fontsize=8)
-        ax.set_xlabel("speed (m/s)", fontsize=7)
-        ax.set_ylabel(unit, fontsize=7)
-        ax.tick_params(labelsize=6)
-        ax.grid(alpha=0.3, linewidth=0.5)
+        axes_style(ax, "speed (m/s)", unit)
         ax.legend(fontsize=6, loc="best")
     fig.suptitle("Stride time and cost of transport against speed (batch.csv)", fontsize=9)
     return png_bytes(fig, plt)

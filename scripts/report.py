@@ -1,7 +1,7 @@
 #!/usr/bin/python3
-"""report.py: figures and a table for a gaitsim solution or sweep folder (`gaitsim report DIR`).
+"""report.py: figures and a table of a gaitsim solution, sweep or batch folder (gaitsim report).
 
-usage: /usr/bin/python3 scripts/report.py DIR [--out D] [--trial T] [--track TRACK_DIR]
+usage: /usr/bin/python3 scripts/report.py DIR [--out D] [--into S] [--trial T] [--track TRACK_DIR]
 
 Like Lin, Walter & Pandy 2018 (Ann Biomed Eng 46:1216) Fig. 1-3 and Table 1, from a solution
 folder (states.sto, controls.sto, grf.mot, summary.json; knee_contact.sto if present) and the
@@ -44,16 +44,30 @@ columns are shown in the table); "nan" values (failed solves) are left out of th
 speeds without a predict_<V>/states.sto (listed in report.md). Body weight per solution:
 summary.json body_weight_n, else its trial's mass.
 
-Output goes to DIR/report/ (or --out); every file is
-written whole (temporary file + rename), report.md last, and only after every input has been
-read and checked, so bad input (missing file or column, NaN) leaves nothing new: one line
-"gaitsim: FILE: reason" on stderr, exit 1. Debian python3-matplotlib and python3-numpy only.
+A batch folder (`gaitsim batch`: batch.csv, plan.json, one folder per solve; recognised by its
+batch.csv) gets the collected results drawn from batch.csv (the columns gs_batch_collect writes;
+solve, command, status, wall_s, stride_time_s, speed_mps, cost_of_transport_j_per_kg_m needed,
+rms_<key> of TABLE1 used where present, empty cells for what a solve lacks):
+- wall_time.png: wall time per solve, coloured by status;
+- gait_speed.png (when a solve has a speed and a stride time or cost of transport): stride time
+  and cost of transport against the solved speed, each sweep of plan.json a line (its solves
+  NAME_<V>), other predictions and the tracks as markers, the paper's stride times marked;
+- rms.png (when a track has RMS errors): the Table 1 RMS errors per track;
+- report.md: the batch table (empty cells as -), the count per status, the sweeps, figure links.
+
+Output goes to DIR/report/ (or --out); `gaitsim report` passes --into, a temporary folder beside
+--out that it renames to --out in one step when this script succeeds and removes when it fails
+(so the folder is whole: the earlier report or the new one). Every file is written whole
+(temporary file + rename), report.md last, and only after every input has been read and checked,
+so bad input (missing file or column, NaN) leaves nothing new: one line "gaitsim: FILE: reason" on
+stderr, exit 1. Debian python3-matplotlib and python3-numpy only.
 """
 import argparse
 import io
 import json
 import math
 import os
+import signal
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -343,12 +357,18 @@ def load(args):
     return d
 
 
-def panel_style(ax, xlabel, ylabel):
-    ax.set_xlim(0, 100)
+def axes_style(ax, xlabel, ylabel):
+    """Axis labels, small ticks and a light grid."""
     ax.set_xlabel(xlabel, fontsize=7)
     ax.set_ylabel(ylabel, fontsize=7)
     ax.tick_params(labelsize=6)
     ax.grid(alpha=0.3, linewidth=0.5)
+
+
+def panel_style(ax, xlabel, ylabel):
+    """A panel over % gait cycle (0..100)."""
+    ax.set_xlim(0, 100)
+    axes_style(ax, xlabel, ylabel)
 
 
 def png_bytes(fig, plt):
@@ -604,11 +624,10 @@ def is_sweep_dir(args):
     return False
 
 
-def read_sweep_csv(path):
-    """(header, rows): rows as dicts of the raw strings plus "_speed" and, for SWEEP_REQUIRED,
-    floats ("nan" allowed: a failed solve); sorted by speed. PrepError on a missing file, a
-    missing required column, a row of the wrong length, a non-numeric required value, a speed
-    that is not a positive number or repeated, or no rows."""
+def read_csv_rows(path, required):
+    """(header, [(line number, row)]): a CSV file's header and its non-blank rows as dicts of the
+    stripped strings. PrepError on a missing or unreadable file, no header, a missing required
+    column or a row of the wrong length."""
     import csv
     try:
         with open(path, encoding="utf-8", newline="") as f:
@@ -620,14 +639,25 @@ def read_sweep_csv(path):
     if not lines:
         raise PrepError(path, "empty (no header line)")
     header = [h.strip() for h in lines[0][1]]
-    missing = [c for c in SWEEP_REQUIRED if c not in header]
+    missing = [c for c in required if c not in header]
     if missing:
         raise PrepError(path, "missing column(s) " + ", ".join(missing))
     rows = []
     for lineno, fields in lines[1:]:
         if len(fields) != len(header):
             raise PrepError(path, f"line {lineno}: {len(fields)} fields, header has {len(header)}")
-        r = {h: x.strip() for h, x in zip(header, fields)}
+        rows.append((lineno, {h: x.strip() for h, x in zip(header, fields)}))
+    return header, rows
+
+
+def read_sweep_csv(path):
+    """(header, rows): rows as dicts of the raw strings plus "_speed" and, for SWEEP_REQUIRED,
+    floats ("nan" allowed: a failed solve); sorted by speed. PrepError on a missing file, a
+    missing required column, a row of the wrong length, a non-numeric required value, a speed
+    that is not a positive number or repeated, or no rows."""
+    header, lines = read_csv_rows(path, SWEEP_REQUIRED)
+    rows = []
+    for lineno, r in lines:
         for c in SWEEP_REQUIRED:
             try:
                 r["_" + c] = float(r[c])
@@ -886,10 +916,7 @@ def fig_sweep_gait(d, plt):
                 ax.plot([tv], [ty], linestyle="none", marker="x", markersize=7, color="black",
                         label="tracking solution")
         ax.set_title(title, fontsize=8)
-        ax.set_xlabel("speed (m/s)", fontsize=7)
-        ax.set_ylabel(unit, fontsize=7)
-        ax.tick_params(labelsize=6)
-        ax.grid(alpha=0.3, linewidth=0.5)
+        axes_style(ax, "speed (m/s)", unit)
         ax.legend(fontsize=6, loc="best")
     fig.suptitle("Stride time, stride length and cost of transport against speed (sweep.csv)",
                  fontsize=9)
@@ -980,22 +1007,221 @@ def sweep_figures(d, plt):
     return figures
 
 
+# ---------------------------------------------------------------------------------------------
+# batch reports: `gaitsim report BATCH_DIR` (a folder with batch.csv, written by `gaitsim batch`):
+# the batch table and figures of the collected results
+
+BATCH_REQUIRED = ["solve", "command", "status", "wall_s", "stride_time_s", "speed_mps",
+                  "cost_of_transport_j_per_kg_m"]
+BATCH_NUMERIC = ["speed_target_mps", "exit", "wall_s", "stride_time_s", "speed_mps",
+                 "cost_of_transport_j_per_kg_m"]
+
+# Table 1 RMS columns of batch.csv (rms_<summary.json key>): (key, quantity, unit)
+BATCH_RMS = [(key, name, unit) for key, name, unit, _ in TABLE1]
+
+# the statuses of gs_batch_record_status and batch-status; others (running, pending) in blue
+STATUS_COLOURS = {"done": "tab:green", "stopped short": "tab:orange", "interrupted": "tab:purple",
+                  "failed": "tab:red", "skipped": "0.6", "not run": "0.6"}
+
+
+def read_batch_csv(path):
+    """(header, rows): rows as dicts of the raw strings plus "_<column>" floats (nan for an empty
+    cell) for BATCH_NUMERIC and the rms_* columns, in file order. PrepError on a missing file, a
+    missing required column, a row of the wrong length, a non-numeric number, a repeated solve or
+    no rows."""
+    header, lines = read_csv_rows(path, BATCH_REQUIRED)
+    numeric = [c for c in header if c in BATCH_NUMERIC or c.startswith("rms_")]
+    rows = []
+    for lineno, r in lines:
+        for c in numeric:
+            try:
+                r["_" + c] = float(r[c]) if r[c] else float("nan")
+            except ValueError:
+                raise PrepError(path, f"line {lineno}: {c} '{r[c]}' is not a number")
+        if not r["solve"]:
+            raise PrepError(path, f"line {lineno}: empty solve name")
+        if any(q["solve"] == r["solve"] for q in rows):
+            raise PrepError(path, f"line {lineno}: solve {r['solve']} repeated")
+        rows.append(r)
+    if not rows:
+        raise PrepError(path, "no data rows")
+    return header, rows
+
+
+def batch_sweeps(batch, rows):
+    """{sweep name: [its rows, slow to fast]} from the batch's plan.json (the solves with
+    "sweep"; their speeds are the rows NAME_<V>); {} without a readable plan.json."""
+    path = os.path.join(batch, "plan.json")
+    if not os.path.isfile(path):
+        return {}
+    solves = read_json(path).get("solves")
+    out = {}
+    for s in solves if isinstance(solves, list) else []:
+        if isinstance(s, dict) and isinstance(s.get("name"), str) and "sweep" in s:
+            mine = [r for r in rows if r["command"] == "predict"
+                    and r["solve"].startswith(s["name"] + "_")]
+            if mine:
+                out[s["name"]] = sorted(mine, key=lambda r: r["_speed_mps"]
+                                        if math.isfinite(r["_speed_mps"]) else math.inf)
+    return out
+
+
+def load_batch(args):
+    batch = args.dir
+    if not os.path.isdir(batch):
+        raise PrepError(batch, "not a folder")
+    d = {"dir": batch, "csv_path": os.path.join(batch, "batch.csv")}
+    d["header"], d["rows"] = read_batch_csv(d["csv_path"])
+    d["sweeps"] = batch_sweeps(batch, d["rows"])
+    in_sweep = {r["solve"] for rows in d["sweeps"].values() for r in rows}
+    d["singles"] = [r for r in d["rows"]
+                    if r["command"] == "predict" and r["solve"] not in in_sweep]
+    d["tracks"] = [r for r in d["rows"] if r["command"] == "track"]
+    d["rms"] = [(k, name, unit) for k, name, unit in BATCH_RMS
+                if any(math.isfinite(r.get("_rms_" + k, math.nan)) for r in d["tracks"])]
+    d["has_speed"] = any(math.isfinite(r["_speed_mps"]) and
+                         (math.isfinite(r["_stride_time_s"]) or
+                          math.isfinite(r["_cost_of_transport_j_per_kg_m"])) for r in d["rows"])
+    return d
+
+
+def fig_batch_wall(d, plt):
+    import numpy as np
+    rows = d["rows"]
+    fig, ax = plt.subplots(figsize=(6.5, 1.2 + 0.28 * len(rows)), layout="constrained")
+    y = np.arange(len(rows))
+    w = [r["_wall_s"] if math.isfinite(r["_wall_s"]) else 0.0 for r in rows]
+    colours = [STATUS_COLOURS.get(r["status"], "tab:blue") for r in rows]
+    ax.barh(y, w, color=colours)
+    ax.set_yticks(y, [r["solve"] for r in rows], fontsize=7)
+    ax.invert_yaxis()
+    for k, r in enumerate(rows):
+        ax.annotate(f" {r['status']}", (w[k], k), va="center", fontsize=6)
+    ax.set_xlabel("wall time (s)", fontsize=7)
+    ax.tick_params(labelsize=6)
+    ax.grid(axis="x", alpha=0.3, linewidth=0.5)
+    ax.set_xlim(0, 1.3 * max(w + [1.0]))
+    fig.suptitle(f"Wall time per solve (batch.csv; {sum(w):.1f} s in all)", fontsize=9)
+    return png_bytes(fig, plt)
+
+
+def fig_batch_speed(d, plt):
+    fig, axes = plt.subplots(1, 2, figsize=(9, 3.6), layout="constrained")
+    cmap = plt.get_cmap("tab10")
+    for ax, key, title, unit in zip(axes, ("stride_time_s", "cost_of_transport_j_per_kg_m"),
+                                    ("stride time", "cost of transport"), ("s", "J/(kg m)")):
+        def points(rows):
+            ok = [r for r in rows if math.isfinite(r["_speed_mps"]) and math.isfinite(r["_" + key])]
+            return [r["_speed_mps"] for r in ok], [r["_" + key] for r in ok]
+        for k, (name, rows) in enumerate(d["sweeps"].items()):
+            ax.plot(*points(rows), color=cmap(k % 10), marker="o", markersize=4, linewidth=1.2,
+                    label=f"sweep {name}")
+        for rows, marker, label in ((d["singles"], "s", "prediction"), (d["tracks"], "x", "track")):
+            x, y = points(rows)
+            if x:
+                ax.plot(x, y, linestyle="none", marker=marker, markersize=6, color="black",
+                        markerfacecolor="none" if marker == "s" else None, label=label)
+        if key == "stride_time_s":
+            ax.plot(*zip(*PAPER_STRIDE_TIME), linestyle="none", marker="*", markersize=10,
+                    color="tab:red", label="Lin et al. 2018, predicted")
+        ax.set_title(title, fontsize=8)
+        axes_style(ax, "speed (m/s)", unit)
+        ax.legend(fontsize=6, loc="best")
+    fig.suptitle("Stride time and cost of transport against speed (batch.csv)", fontsize=9)
+    return png_bytes(fig, plt)
+
+
+def fig_batch_rms(d, plt):
+    import numpy as np
+    n = len(d["rms"])
+    fig, axes = panel_grid(plt, n, 4, 2.6, 2.2, 0.6)
+    names = [r["solve"] for r in d["tracks"]]
+    x = np.arange(len(names))
+    for ax, (key, title, unit) in zip(axes, d["rms"]):
+        v = [r.get("_rms_" + key, math.nan) for r in d["tracks"]]
+        ax.bar(x, [q if math.isfinite(q) else 0.0 for q in v], color="tab:blue")
+        ax.set_xticks(x, names, fontsize=6, rotation=45, ha="right")
+        ax.set_title(title, fontsize=8)
+        ax.set_ylabel(unit, fontsize=7)
+        ax.tick_params(labelsize=6)
+        ax.grid(axis="y", alpha=0.3, linewidth=0.5)
+    fig.suptitle("Tracking errors per track, RMS (cf. Lin et al. 2018 Table 1; batch.csv)",
+                 fontsize=9)
+    return png_bytes(fig, plt)
+
+
+def batch_figures(d, plt):
+    figures = {"wall_time.png": fig_batch_wall(d, plt)}
+    if d["has_speed"]:
+        figures["gait_speed.png"] = fig_batch_speed(d, plt)
+    if d["rms"]:
+        figures["rms.png"] = fig_batch_rms(d, plt)
+    return figures
+
+
+def batch_report_md(d, figures):
+    rows = d["rows"]
+    counts = {}
+    for r in rows:
+        counts[r["status"]] = counts.get(r["status"], 0) + 1
+    wall = sum(r["_wall_s"] for r in rows if math.isfinite(r["_wall_s"]))
+    lines = ["# gaitsim batch report", "",
+             f"Batch `{os.path.abspath(d['dir'])}`: {len(rows)} solve(s) in batch.csv: "
+             + ", ".join(f"{n} {s}" for s, n in counts.items())
+             + f"; wall time {wall:.1f} s in all (the solves' own, summed).", "",
+             "## Batch table (batch.csv)", "",
+             "| " + " | ".join(d["header"]) + " |", "|" + "---|" * len(d["header"])]
+    for r in rows:
+        lines.append("| " + " | ".join(r[h] if r[h] else "-" for h in d["header"]) + " |")
+    lines += ["", "-: not in the solve's summary.json (no result, or not a track for the RMS "
+              "columns).", ""]
+    if d["sweeps"]:
+        lines += ["Sweeps (plan.json): " + "; ".join(
+            f"{name}: " + ", ".join(r["solve"] for r in rs) for name, rs in d["sweeps"].items())
+            + ".", ""]
+    captions = {
+        "wall_time.png": "Wall time per solve (the batch's record of each), coloured by status.",
+        "gait_speed.png": "Stride time and cost of transport against the solved speed: each sweep "
+                          "a line, other predictions as squares, tracks as x, the paper's "
+                          "predicted stride times at 0.8 and 2.0 m/s as stars.",
+        "rms.png": "Table 1 RMS tracking errors per track (the rms_* columns of batch.csv).",
+    }
+    lines += ["## Figures", ""]
+    for name in figures:
+        lines += [f"![{name}]({name})", "", captions[name], ""]
+    if "gait_speed.png" not in figures:
+        lines += ["No solve with a speed and a stride time or cost of transport: no "
+                  "gait_speed.png.", ""]
+    if "rms.png" not in figures:
+        lines += ["No track with RMS errors: no rms.png.", ""]
+    return "\n".join(lines)
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="gaitsim report", description=__doc__.splitlines()[0])
-    ap.add_argument("dir", help="solution folder, or sweep folder (sweep.csv, predict_*/)")
+    ap.add_argument("dir", help="solution folder, sweep folder (sweep.csv, predict_*/) or batch "
+                    "folder (batch.csv)")
     ap.add_argument("--out", default=None, help="output folder (default DIR/report)")
+    ap.add_argument("--into", default=None,
+                    help="write into this folder instead of --out (gaitsim report: its temporary "
+                         "folder, renamed to --out when this succeeds); messages name --out")
     ap.add_argument("--trial", default=None, help="measured trial folder (default: summary.json trial)")
     ap.add_argument("--track", default=None,
                     help="sweep folder only: the tracking solution (default: the predictions' guess)")
     args = ap.parse_args(argv)
     out = args.out or os.path.join(args.dir, "report")
+    into = args.into or out
     try:
-        sweep = is_sweep_dir(args)
-        d = load_sweep(args) if sweep else load(args)
+        batch = not args.track and os.path.isfile(os.path.join(args.dir, "batch.csv"))
+        sweep = not batch and is_sweep_dir(args)
+        d = load_batch(args) if batch else load_sweep(args) if sweep else load(args)
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
-        if sweep:
+        if batch:
+            figures = batch_figures(d, plt)
+            text = batch_report_md(d, list(figures))
+        elif sweep:
             figures = sweep_figures(d, plt)
             text = sweep_report_md(d, list(figures))
         else:
@@ -1004,9 +1230,11 @@ def main(argv=None):
                 figures["knee_contact.png"] = fig_knee(d, plt)
             figures["excitations.png"] = fig_excitations(d, plt)
             text = report_md(d, list(figures))
-        for name, data in figures.items():
-            write_atomic(os.path.join(out, name), data)
-        write_atomic(os.path.join(out, "report.md"), text)
+        for name, data in list(figures.items()) + [("report.md", text)]:
+            try:
+                write_atomic(os.path.join(into, name), data)
+            except OSError as e:  # named as in --out, where the file would have gone
+                raise PrepError(os.path.join(out, name), e.strerror or str(e))
     except PrepError as e:
         print(f"gaitsim: {e.file}: {e.reason}", file=sys.stderr)
         return 1
@@ -1018,4 +1246,6 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
+    if signal.getsignal(signal.SIGINT) is signal.default_int_handler:  # not ignored (nohup, &)
+        signal.signal(signal.SIGINT, signal.SIG_DFL)  # Ctrl-C ends it at once, no traceback
     sys.exit(main())

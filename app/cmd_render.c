@@ -30,7 +30,8 @@ static const char* kRenderUsage =
     "OUTPUT (one of):\n"
     "  --out FILE.mp4     H.264 video through ffmpeg; without ffmpeg on PATH, PNG frames are\n"
     "                     written instead (to --frames DIR, else FILE_frames/)\n"
-    "  --frames DIR       numbered PNG frames DIR/frame_00000.png ... (also with --out)\n"
+    "  --frames DIR       numbered PNG frames DIR/frame_00000.png ... (also with --out); DIR is\n"
+    "                     replaced whole, and only when it holds earlier frames (frame_00000.png)\n"
     "  --png FILE         one frame at --at A (fraction of the cycle, default 0)\n"
     "  --strip FILE       --count N frames (default 8) across the cycle, side by side\n"
     "options:\n"
@@ -39,7 +40,9 @@ static const char* kRenderUsage =
     "  --cycles N         strides shown in a video, repeated with forward translation, default 1\n"
     "  --camera VIEW      side (default), front or follow; the camera follows the pelvis\n"
     "  --quality Q        fast (default) or high (shadows, reflections, 4x multisampling)\n"
-    "  --no-overlay       no time / % cycle text\n";
+    "  --no-overlay       no time / % cycle text\n"
+    "Every output is written beside its name first and put in place when complete: SIGINT,\n"
+    "SIGTERM or SIGHUP ends render at once, removing what it had written.\n";
 
 // --size "WxH" -> w, h (16..8192 each); prints the reason
 static int parse_size(const char* s, int* w, int* h) {

@@ -94,10 +94,10 @@ void gs_folder_abort(gsFolderTx* tx);
 // side by side: a video and its frames); only one of them is committed or aborted at a time.
 void gs_folder_abort_from_signal(void);
 
-// For a command that stops at once on a signal (render, simulate's second signal is the
-// solver's): SIGINT, SIGTERM and SIGHUP write `line` (one line, newline added) on stderr, remove
-// the open transactions' temporary folders (gs_folder_abort_from_signal) and end the process by
-// that signal (exit status 128 + signal in a shell). Nothing when a SIGINT handler is already
+// For a command that stops at once on a signal (render): SIGINT, SIGTERM and SIGHUP write
+// `line` (one line, newline added) on stderr, remove the open transactions' temporary folders
+// (gs_folder_abort_from_signal) and end the process by that signal (exit status 128 + signal
+// in a shell). Nothing when a SIGINT handler is already
 // installed (e.g. the solver's stop signals, go_ipopt_install_stop_signals, when `run` renders:
 // the render then completes and `run` stops after it). 0, or -1 when sigaction fails.
 int gs_folder_abort_on_signals(const char* line);

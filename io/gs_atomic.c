@@ -467,6 +467,16 @@ static void sync_dir(const char* dir) {
   }
 }
 
+// after a rename into place: fsync path's parent folder (best effort); tx keeps the parents it
+// made, which now hold the result
+static void published(gsFolderTx* tx) {
+  char* parent = dir_of(tx->path);
+  if (parent) sync_dir(parent);
+  free(parent);
+  free(tx->made);
+  tx->made = NULL;
+}
+
 int gs_folder_commit(gsFolderTx* tx, char* err, int errsz) {
   if (!tx || !tx->staging || !tx->path) {
     gs_error_set(err, errsz, "gs_folder_commit: no folder open");
@@ -477,11 +487,7 @@ int gs_folder_commit(gsFolderTx* tx, char* err, int errsz) {
   staging_pop(tx->staging);  // from here on the temporary name may hold the old folder
   // a new folder: one rename
   if (rename(tx->staging, tx->path) == 0) {
-    char* parent = dir_of(tx->path);
-    if (parent) sync_dir(parent);
-    free(parent);
-    free(tx->made);
-    tx->made = NULL;
+    published(tx);
     folder_release(tx);
     return 0;
   }
@@ -518,13 +524,9 @@ int gs_folder_commit(gsFolderTx* tx, char* err, int errsz) {
     gs_folder_abort(tx);
     return -1;
   }
-  char* parent = dir_of(tx->path);
-  if (parent) sync_dir(parent);
-  free(parent);
+  published(tx);
   // the old folder, now under the temporary name
   if (tx->staging) gs_remove_tree(tx->staging, NULL, 0);
-  free(tx->made);
-  tx->made = NULL;
   folder_release(tx);
   return 0;
 }
@@ -551,12 +553,8 @@ int gs_folder_commit_file(gsFolderTx* tx, char* err, int errsz) {
     gs_folder_abort(tx);
     return -1;
   }
-  char* parent = dir_of(tx->path);
-  if (parent) sync_dir(parent);
-  free(parent);
+  published(tx);
   // the temporary folder, now empty but for what the writer left beside its file
-  free(tx->made);
-  tx->made = NULL;
   gs_folder_abort(tx);
   return 0;
 }
@@ -612,15 +610,11 @@ void gs_folder_abort_from_signal(void) {
 static char g_stop_line[256];
 static size_t g_stop_len = 0;
 
+// installed with SA_RESETHAND | SA_NODEFER: the signal raised again ends the process
 static void on_abort_signal(int sig) {
   ssize_t w = write(2, g_stop_line, g_stop_len);
   (void)w;
   gs_folder_abort_from_signal();
-  signal(sig, SIG_DFL);
-  sigset_t unblock;
-  sigemptyset(&unblock);
-  sigaddset(&unblock, sig);
-  sigprocmask(SIG_UNBLOCK, &unblock, NULL);
   raise(sig);
   _exit(128 + sig);
 }
@@ -636,6 +630,7 @@ int gs_folder_abort_on_signals(const char* line) {
   struct sigaction sa;
   memset(&sa, 0, sizeof(sa));
   sa.sa_handler = on_abort_signal;
+  sa.sa_flags = SA_RESETHAND | SA_NODEFER;
   sigemptyset(&sa.sa_mask);
   for (int i = 0; i < 3; i++) sigaddset(&sa.sa_mask, sigs[i]);
   for (int i = 0; i < 3; i++)

@@ -238,7 +238,7 @@ int gs_cmd_sweep(int argc, char** argv) {
                     "GRF (BW); nodes in flight, in double support | status |\n"
                     "|---|---|---|---|---|---|---|---|---|---|---|\n");
   double sol_ex[SWEEP_MAX_SPEEDS], gas_ex[SWEEP_MAX_SPEEDS];
-  int written = 0;  // speeds whose folder was written
+  int written = 0;  // speeds whose folder was written (converged, stopped short or interrupted)
   for (int i = 0; i < n; i++) {
     snprintf(sol, sizeof(sol), "%s/predict_%.4g", dir, v[i]);
     written += access(sol, F_OK) == 0;
@@ -307,7 +307,7 @@ int gs_cmd_sweep(int argc, char** argv) {
     fprintf(stderr, "gaitsim: %s\n", err);
     return GS_EXIT_FAILURE;
   }
-  printf("sweep: wrote %s (%d of %d speeds solved)\n", final_dir, written, n);
+  printf("sweep: wrote %s (%d of %d speeds written)\n", final_dir, written, n);
   fputs(md, stdout);
   for (int r = 0; r < 2; r++) {
     int rc = r ? rc_up : rc_down;

@@ -14,6 +14,7 @@
 #include "app/gs_commands.h"
 #include "app/gs_options.h"
 #include "callbacks/gs_mujoco.h"
+#include "io/gs_atomic.h"
 #include "render/gr_image.h"
 #include "render/gr_render.h"
 
@@ -29,7 +30,8 @@ static const char* kRenderUsage =
     "OUTPUT (one of):\n"
     "  --out FILE.mp4     H.264 video through ffmpeg; without ffmpeg on PATH, PNG frames are\n"
     "                     written instead (to --frames DIR, else FILE_frames/)\n"
-    "  --frames DIR       numbered PNG frames DIR/frame_00000.png ... (also with --out)\n"
+    "  --frames DIR       numbered PNG frames DIR/frame_00000.png ... (also with --out); DIR is\n"
+    "                     replaced whole, and only when it holds earlier frames (frame_00000.png)\n"
     "  --png FILE         one frame at --at A (fraction of the cycle, default 0)\n"
     "  --strip FILE       --count N frames (default 8) across the cycle, side by side\n"
     "options:\n"
@@ -38,7 +40,9 @@ static const char* kRenderUsage =
     "  --cycles N         strides shown in a video, repeated with forward translation, default 1\n"
     "  --camera VIEW      side (default), front or follow; the camera follows the pelvis\n"
     "  --quality Q        fast (default) or high (shadows, reflections, 4x multisampling)\n"
-    "  --no-overlay       no time / % cycle text\n";
+    "  --no-overlay       no time / % cycle text\n"
+    "Every output is written beside its name first and put in place when complete: SIGINT,\n"
+    "SIGTERM or SIGHUP ends render at once, removing what it had written.\n";
 
 // --size "WxH" -> w, h (16..8192 each); prints the reason
 static int parse_size(const char* s, int* w, int* h) {
@@ -199,22 +203,49 @@ int gs_cmd_render(int argc, char** argv) {
   }
   int status = GS_EXIT_FAILURE;
   grRenderer r;
+  // every output is written whole: into a temporary folder beside it, then put in place (the
+  // frames' folder replaces DIR; a file is renamed out of it), so that a failure or a stop signal
+  // leaves nothing partial and no stale frame of an earlier render stays in DIR
+  gsFolderTx tx_file = {NULL, NULL, NULL}, tx_frames = {NULL, NULL, NULL};
+  const char* file = png ? png : strip ? strip : out;
+  char staged_file[8300], staged_frames[4200];
+  if (frames && gs_folder_replaceable(frames, "frame_00000.png", err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s\n", err);
+    mj_deleteModel(m);
+    gr_motion_free(&mo);
+    return GS_EXIT_FAILURE;
+  }
+  gs_folder_abort_on_signals("gaitsim: render: stopped by a signal; nothing written");
   if (gr_renderer_create(m, &ro, &r, err, sizeof(err)) != 0) {
     fprintf(stderr, "gaitsim: render: %s\n", err);
     goto done;
   }
+  if (file) {
+    if (gs_folder_begin(&tx_file, file, err, sizeof(err)) != 0) goto fail;
+    const char* base = strrchr(tx_file.path, '/') ? strrchr(tx_file.path, '/') + 1 : tx_file.path;
+    snprintf(staged_file, sizeof(staged_file), "%s/%s", tx_file.staging, base);
+  }
+  if (frames) {
+    if (gs_folder_begin(&tx_frames, frames, err, sizeof(err)) != 0) goto fail;
+    snprintf(staged_frames, sizeof(staged_frames), "%s", tx_frames.staging);
+  }
   double t_start = now_s();
   if (png) {
-    if (gr_render_png(&r, &mo, at, png, err, sizeof(err)) != 0) goto fail;
+    if (gr_render_png(&r, &mo, at, staged_file, err, sizeof(err)) != 0) goto fail;
+    if (gs_folder_commit_file(&tx_file, err, sizeof(err)) != 0) goto fail;
     printf("render: wrote %s (%dx%d, %.0f %% of the cycle)\n", png, ro.width, ro.height,
            100 * at);
   } else if (strip) {
-    if (gr_render_strip(&r, &mo, count, strip, err, sizeof(err)) != 0) goto fail;
+    if (gr_render_strip(&r, &mo, count, staged_file, err, sizeof(err)) != 0) goto fail;
+    if (gs_folder_commit_file(&tx_file, err, sizeof(err)) != 0) goto fail;
     printf("render: wrote %s (%d frames of %dx%d)\n", strip, count, ro.width, ro.height);
   } else {
-    grVideoJob job = {fps, cycles, out, out ? ffmpeg : NULL, frames};
+    grVideoJob job = {fps, cycles, out ? staged_file : NULL, out ? ffmpeg : NULL,
+                      frames ? staged_frames : NULL};
     long n = 0;
     if (gr_render_video(&r, &mo, &job, &n, err, sizeof(err)) != 0) goto fail;
+    if (out && gs_folder_commit_file(&tx_file, err, sizeof(err)) != 0) goto fail;
+    if (frames && gs_folder_commit(&tx_frames, err, sizeof(err)) != 0) goto fail;
     double wall = now_s() - t_start;
     printf("render: wrote %s%s%s: %ld frames, %dx%d, %d fps, %d cycle%s of %.3f s\n",
            out ? out : "", out && frames ? " and " : "", frames ? frames : "", n, ro.width,
@@ -226,6 +257,8 @@ int gs_cmd_render(int argc, char** argv) {
 fail:
   fprintf(stderr, "gaitsim: %s\n", err);
 done:
+  gs_folder_abort(&tx_file);  // nothing when committed
+  gs_folder_abort(&tx_frames);
   gr_renderer_free(&r);
   gr_motion_free(&mo);
   mj_deleteModel(m);

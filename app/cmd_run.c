@@ -133,11 +133,15 @@ int gs_cmd_run(int argc, char** argv) {
       return GS_EXIT_USAGE;
     }
   }
-  // the solution folders it replaces must be earlier results (summary.json) or absent
+  // the folders it replaces must be earlier results (a solution's summary.json, a sweep's
+  // sweep.csv) or absent; each is written whole by its step (track, sweep), so a failed or
+  // interrupted run leaves the steps that finished and no half-written folder
   char err[1024], sub_dir[4200];
-  for (int i = 0; i < 2; i++) {
-    snprintf(sub_dir, sizeof(sub_dir), "%s/%s", out, i ? "track_n20" : "track");
-    if (gs_folder_replaceable(sub_dir, "summary.json", err, sizeof(err)) != 0) {
+  static const char* const kSteps[3][2] = {
+      {"track", "summary.json"}, {"track_n20", "summary.json"}, {"sweep", "sweep.csv"}};
+  for (int i = 0; i < 3; i++) {
+    snprintf(sub_dir, sizeof(sub_dir), "%s/%s", out, kSteps[i][0]);
+    if (gs_folder_replaceable(sub_dir, kSteps[i][1], err, sizeof(err)) != 0) {
       fprintf(stderr, "gaitsim: %s\n", err);
       return GS_EXIT_FAILURE;
     }

@@ -16,6 +16,7 @@
 #include "callbacks/gs_physics.h"
 #include "callbacks/gs_state.h"
 #include "io/gs_atomic.h"
+#include "optim/go_ipopt.h"
 
 static const char* kSimulateUsage =
     "usage: gaitsim simulate MODEL --out DIR [options]\n\n"
@@ -223,7 +224,10 @@ int gs_cmd_simulate(int argc, char** argv) {
   if (o.hold) {
     hold_joints(m, d);
   }
-  // written into a temporary folder beside --out that replaces it at the end
+  // written into a temporary folder beside --out that replaces it at the end; a stop signal
+  // (SIGINT, SIGTERM, SIGHUP) ends the simulation at the next step and writes the rows so far
+  // (exit 3), a second one removes the temporary folder and ends the process at once
+  go_ipopt_install_stop_signals(gs_folder_abort_from_signal);
   if (gs_folder_begin(&tx, o.out, err, sizeof(err)) != 0) {
     fprintf(stderr, "gaitsim: %s\n", err);
     goto done;
@@ -246,9 +250,15 @@ int gs_cmd_simulate(int argc, char** argv) {
     goto done;
   }
 
-  int row = 0, finite = 1;
+  int row = 0, finite = 1, stopped = 0;
   double t0 = d->time;
   for (int s = 0; s <= steps; s++) {
+    if (go_ipopt_stop_signals() > 0) {
+      stopped = 1;
+      fprintf(stderr, "gaitsim: simulate: stopped by a signal at t = %.4f s; writing the %d rows "
+              "before it\n", d->time - t0, row);
+      break;
+    }
     if (o.excitations) {
       gs_state_apply(m, &excitations, &xmap, excitations.time[0] + d->time - t0, d);
     }
@@ -291,7 +301,7 @@ int gs_cmd_simulate(int argc, char** argv) {
            d->time - t0, steps, last[1], last[10], (last[1] + last[10]) / weight);
   }
   printf("simulate: wrote %s/states.sto, grf.mot, muscle_forces.sto\n", o.out);
-  status = finite ? GS_EXIT_OK : GS_EXIT_FAILURE;
+  status = !finite ? GS_EXIT_FAILURE : stopped ? GS_EXIT_STOPPED_SHORT : GS_EXIT_OK;
 
 done:
   gs_folder_abort(&tx);  // nothing when committed

@@ -31,7 +31,12 @@ static const char* kSweepUsage =
     "Predictive solves (gaitsim predict) at every speed of LIST, by continuation from the nearest\n"
     "speed already solved; speeds below and above the guess's own speed run in two processes.\n"
     "LIST is A:STEP:B (m/s, e.g. 0.8:0.2:2.0) or comma-separated speeds. Writes DIR/predict_V/\n"
-    "(the solver's progress in DIR/predict_V/log.txt), DIR/sweep.csv and DIR/sweep.md.\n\n"
+    "(the solver's progress in DIR/predict_V/log.txt), DIR/sweep.csv and DIR/sweep.md.\n"
+    "DIR is written whole: into .DIR.tmp.XXXXXX beside it, which replaces DIR at the end (an\n"
+    "existing DIR only when it holds an earlier sweep, sweep.csv). A stop signal (SIGINT,\n"
+    "SIGTERM, SIGHUP) reaches both processes: the running solves write their best iterates and\n"
+    "DIR holds the speeds solved, the table saying which were not (exit 3); a second signal\n"
+    "ends the sweep at once and DIR stays as it was. No speed solved: DIR stays as it was.\n\n"
     "  --nodes N       collocation nodes (default 20)\n"
     "  --max-time S    wall-clock limit of each solve, s (default none: the iteration limit,\n"
     "                  so that the results do not depend on the load of the machine)\n"
@@ -89,6 +94,15 @@ static int solve_one(const char* guess, double v, const char* out, const char* n
     fclose(lf);
   }
   close(saved);
+  // a failed solve: its reason (the last "gaitsim:" line of its log) on stderr too
+  FILE* rf = rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT ? fopen(log, "r") : NULL;
+  if (rf) {
+    char line[1024], last[1024] = "";
+    while (fgets(line, sizeof(line), rf))
+      if (strncmp(line, "gaitsim: ", 9) == 0) snprintf(last, sizeof(last), "%s", line);
+    fclose(rf);
+    if (last[0]) fprintf(stderr, "gaitsim: sweep: %s m/s: %s", speed, last + 9);
+  }
   if (lf && access(out, F_OK) == 0 && rename(log, final_log) != 0)
     fprintf(stderr, "gaitsim: %s: %s\n", final_log, strerror(errno));
   printf("sweep: %s m/s from %s: exit %d (%s)\n", speed, guess, rc, out);
@@ -153,11 +167,21 @@ int gs_cmd_sweep(int argc, char** argv) {
     fprintf(stderr, "gaitsim: %s/summary.json: no speed_mps (not a solution folder?)\n", guess);
     return GS_EXIT_FAILURE;
   }
-  char err[256];
-  if (gs_mkdir_p(dir, err, sizeof(err)) != 0) {
-    fprintf(stderr, "gaitsim: %s: %s\n", dir, err);
+  // the sweep is written whole: into a temporary folder beside DIR that replaces DIR at the end,
+  // so that no predict_V of an earlier sweep stays beside the new ones; an existing DIR is
+  // replaced only when it holds an earlier sweep
+  char err[1024];
+  if (gs_folder_replaceable(dir, "sweep.csv", err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s\n", err);
     return GS_EXIT_FAILURE;
   }
+  gsFolderTx tx;
+  if (gs_folder_begin(&tx, dir, err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s\n", err);
+    return GS_EXIT_FAILURE;
+  }
+  const char* final_dir = dir;
+  dir = tx.staging;
   // the chains: downwards from the guess's speed, upwards from it
   int down[SWEEP_MAX_SPEEDS], up[SWEEP_MAX_SPEEDS], nd = 0, nu = 0;
   for (int i = n - 1; i >= 0; i--)
@@ -214,8 +238,10 @@ int gs_cmd_sweep(int argc, char** argv) {
                     "GRF (BW); nodes in flight, in double support | status |\n"
                     "|---|---|---|---|---|---|---|---|---|---|---|\n");
   double sol_ex[SWEEP_MAX_SPEEDS], gas_ex[SWEEP_MAX_SPEEDS];
+  int written = 0;  // speeds whose folder was written (converged, stopped short or interrupted)
   for (int i = 0; i < n; i++) {
     snprintf(sol, sizeof(sol), "%s/predict_%.4g", dir, v[i]);
+    written += access(sol, F_OK) == 0;
     snprintf(path, sizeof(path), "%s/summary.json", sol);
     cJSON* j = gs_app_read_json(path);
     // walk or run: summary.json's lowest summed vertical force and flight, double-support nodes
@@ -228,7 +254,7 @@ int gs_cmd_sweep(int argc, char** argv) {
       f[q] = cJSON_IsNumber(x) ? x->valuedouble : NAN;
     }
     const cJSON* st = cJSON_GetObjectItemCaseSensitive(j, "status");
-    const char* status = cJSON_IsString(st) ? st->valuestring : "missing";
+    const char* status = cJSON_IsString(st) ? st->valuestring : "not solved";
     // right leg: soleus; gastrocnemius the larger of its heads (JW's right-leg names)
     const cJSON* pe = cJSON_GetObjectItemCaseSensitive(j, "peak_excitation");
     const cJSON* so = cJSON_GetObjectItemCaseSensitive(pe, "soleus");
@@ -265,14 +291,23 @@ int gs_cmd_sweep(int argc, char** argv) {
                    "(stride %.3f s, %.3f m).\n",
                    v[n - 1], v[0], sol_ex[n - 1] / sol_ex[0], gas_ex[n - 1] / gas_ex[0], guess,
                    T0, L0);
+  // what finished replaces DIR (a sweep stopped by a signal or a failed speed: the speeds
+  // solved, the table saying which); nothing finished: DIR stays as it was
+  if (written == 0) {
+    gs_folder_abort(&tx);
+    printf("sweep: no speed was solved; %s left as it was\n", final_dir);
+    return rc_down != GS_EXIT_OK ? rc_down : rc_up != GS_EXIT_OK ? rc_up : GS_EXIT_FAILURE;
+  }
   snprintf(path, sizeof(path), "%s/sweep.csv", dir);
   int ok = gs_atomic_write_buffer(path, csv, strlen(csv), err, sizeof(err)) == 0;
   snprintf(path, sizeof(path), "%s/sweep.md", dir);
   ok = ok && gs_atomic_write_buffer(path, md, strlen(md), err, sizeof(err)) == 0;
-  if (!ok) {
-    fprintf(stderr, "gaitsim: %s: %s\n", path, err);
+  if (!ok || gs_folder_commit(&tx, err, sizeof(err)) != 0) {
+    gs_folder_abort(&tx);
+    fprintf(stderr, "gaitsim: %s\n", err);
     return GS_EXIT_FAILURE;
   }
+  printf("sweep: wrote %s (%d of %d speeds written)\n", final_dir, written, n);
   fputs(md, stdout);
   for (int r = 0; r < 2; r++) {
     int rc = r ? rc_up : rc_down;

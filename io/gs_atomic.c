@@ -273,9 +273,29 @@ int gs_mkdir_p(const char* path, char* err, int errsz) {
 
 // --- whole folders ------------------------------------------------------------------------------
 
-// the open transaction's temporary folder, for gs_folder_abort_from_signal (one per process)
-static char g_staging[4096];
-static volatile sig_atomic_t g_staging_set = 0;
+// the open transactions' temporary folders, for gs_folder_abort_from_signal: a stack, since a
+// sweep's folder holds the folders of its solves (entries [0, g_nstaging) are valid)
+#define GS_MAX_OPEN_FOLDERS 4
+static char g_staging[GS_MAX_OPEN_FOLDERS][4096];
+static volatile sig_atomic_t g_nstaging = 0;
+
+// register staging as open (nothing when the stack is full or the path too long)
+static void staging_push(const char* staging) {
+  int n = g_nstaging;
+  if (n < GS_MAX_OPEN_FOLDERS && strlen(staging) < sizeof(g_staging[0])) {
+    memcpy(g_staging[n], staging, strlen(staging) + 1);
+    g_nstaging = n + 1;
+  }
+}
+
+// drop staging, and the entries above it, from the stack
+static void staging_pop(const char* staging) {
+  for (int i = g_nstaging - 1; staging && i >= 0; i--)
+    if (strcmp(g_staging[i], staging) == 0) {
+      g_nstaging = i;
+      return;
+    }
+}
 
 // lstat path: 1 it exists, 0 it does not, -1 another error (with the reason)
 static int lstat_entry(const char* path, struct stat* st, char* err, int errsz) {
@@ -346,8 +366,9 @@ int gs_folder_replaceable(const char* path, const char* marker, char* err, int e
   }
   closedir(d);
   if (entries > 0 && !has_marker) {
-    gs_error_set(err, errsz, "%s: exists and holds no %s (not a result of gaitsim), so it is not "
-                 "replaced: choose another folder or remove it", path, marker);
+    gs_error_set(err, errsz, "%s: exists and holds no %s (not an earlier result of this "
+                 "command), so it is not replaced: choose another folder or remove it", path,
+                 marker);
     return -1;
   }
   return 0;
@@ -355,11 +376,11 @@ int gs_folder_replaceable(const char* path, const char* marker, char* err, int e
 
 // release the strings and zero the struct
 static void folder_release(gsFolderTx* tx) {
+  staging_pop(tx->staging);
   free(tx->path);
   free(tx->staging);
   free(tx->made);
   tx->path = tx->staging = tx->made = NULL;
-  g_staging_set = 0;
 }
 
 // the first missing ancestor of path that mkdir -p would create (malloc'ed), or NULL
@@ -425,16 +446,13 @@ int gs_folder_begin(gsFolderTx* tx, const char* path, char* err, int errsz) {
   mode_t um = umask(0);
   umask(um);
   chmod(tx->staging, 0777 & ~um);
-  if (strlen(tx->staging) < sizeof(g_staging)) {
-    memcpy(g_staging, tx->staging, strlen(tx->staging) + 1);
-    g_staging_set = 1;
-  }
+  staging_push(tx->staging);
   return 0;
 }
 
 void gs_folder_abort(gsFolderTx* tx) {
   if (!tx) return;
-  g_staging_set = 0;
+  staging_pop(tx->staging);
   if (tx->staging) gs_remove_tree(tx->staging, NULL, 0);
   if (tx->made) gs_remove_tree(tx->made, NULL, 0);
   folder_release(tx);
@@ -449,6 +467,16 @@ static void sync_dir(const char* dir) {
   }
 }
 
+// after a rename into place: fsync path's parent folder (best effort); tx keeps the parents it
+// made, which now hold the result
+static void published(gsFolderTx* tx) {
+  char* parent = dir_of(tx->path);
+  if (parent) sync_dir(parent);
+  free(parent);
+  free(tx->made);
+  tx->made = NULL;
+}
+
 int gs_folder_commit(gsFolderTx* tx, char* err, int errsz) {
   if (!tx || !tx->staging || !tx->path) {
     gs_error_set(err, errsz, "gs_folder_commit: no folder open");
@@ -456,14 +484,10 @@ int gs_folder_commit(gsFolderTx* tx, char* err, int errsz) {
     return -1;
   }
   sync_dir(tx->staging);
-  g_staging_set = 0;  // from here on the temporary name may hold the old folder
+  staging_pop(tx->staging);  // from here on the temporary name may hold the old folder
   // a new folder: one rename
   if (rename(tx->staging, tx->path) == 0) {
-    char* parent = dir_of(tx->path);
-    if (parent) sync_dir(parent);
-    free(parent);
-    free(tx->made);
-    tx->made = NULL;
+    published(tx);
     folder_release(tx);
     return 0;
   }
@@ -500,14 +524,38 @@ int gs_folder_commit(gsFolderTx* tx, char* err, int errsz) {
     gs_folder_abort(tx);
     return -1;
   }
-  char* parent = dir_of(tx->path);
-  if (parent) sync_dir(parent);
-  free(parent);
+  published(tx);
   // the old folder, now under the temporary name
   if (tx->staging) gs_remove_tree(tx->staging, NULL, 0);
-  free(tx->made);
-  tx->made = NULL;
   folder_release(tx);
+  return 0;
+}
+
+int gs_folder_commit_file(gsFolderTx* tx, char* err, int errsz) {
+  if (!tx || !tx->staging || !tx->path) {
+    gs_error_set(err, errsz, "gs_folder_commit_file: no folder open");
+    gs_folder_abort(tx);
+    return -1;
+  }
+  const char* base = strrchr(tx->path, '/') ? strrchr(tx->path, '/') + 1 : tx->path;
+  size_t n = strlen(tx->staging) + strlen(base) + 2;
+  char* inner = malloc(n);
+  if (!inner) {
+    gs_error_set(err, errsz, "%s: out of memory", tx->path);
+    gs_folder_abort(tx);
+    return -1;
+  }
+  snprintf(inner, n, "%s/%s", tx->staging, base);
+  int rc = rename(inner, tx->path);
+  free(inner);
+  if (rc != 0) {
+    gs_error_set(err, errsz, "%s: cannot rename temporary file: %s", tx->path, strerror(errno));
+    gs_folder_abort(tx);
+    return -1;
+  }
+  published(tx);
+  // the temporary folder, now empty but for what the writer left beside its file
+  gs_folder_abort(tx);
   return 0;
 }
 
@@ -520,23 +568,72 @@ struct gs_dirent64 {
   char d_name[];
 };
 
-void gs_folder_abort_from_signal(void) {
-  if (!g_staging_set) return;
-  int dfd = open(g_staging, O_RDONLY | O_DIRECTORY);
-  if (dfd >= 0) {
-    char buf[4096] __attribute__((aligned(8)));
+// remove everything below the open folder dfd and close it, with async-signal-safe calls only;
+// depth: how many levels of folders below it are removed too
+static void remove_below_from_signal(int dfd, int depth) {
+  char buf[2048] __attribute__((aligned(8)));
+  // entries removed while the folder is read may be skipped: read it again until nothing is left
+  for (int pass = 0, removed = 1; removed && pass < 16; pass++) {
+    removed = 0;
+    lseek(dfd, 0, SEEK_SET);
     long n;
     while ((n = syscall(SYS_getdents64, dfd, buf, sizeof(buf))) > 0) {
       for (long off = 0; off < n;) {
         struct gs_dirent64* e = (struct gs_dirent64*)(buf + off);
         const char* name = e->d_name;
-        if (!(name[0] == '.' && (name[1] == 0 || (name[1] == '.' && name[2] == 0))))
-          unlinkat(dfd, name, 0);
         off += e->d_reclen;
+        if (name[0] == '.' && (name[1] == 0 || (name[1] == '.' && name[2] == 0))) continue;
+        if (unlinkat(dfd, name, 0) == 0) {
+          removed = 1;
+        } else if (depth > 0) {
+          int sub = openat(dfd, name, O_RDONLY | O_DIRECTORY | O_NOFOLLOW);
+          if (sub >= 0) remove_below_from_signal(sub, depth - 1);
+          if (unlinkat(dfd, name, AT_REMOVEDIR) == 0) removed = 1;
+        }
       }
     }
-    close(dfd);
   }
-  rmdir(g_staging);
-  g_staging_set = 0;
+  close(dfd);
+}
+
+void gs_folder_abort_from_signal(void) {
+  // the innermost first: a solve's folder inside a sweep's
+  for (int i = g_nstaging - 1; i >= 0; i--) {
+    int dfd = open(g_staging[i], O_RDONLY | O_DIRECTORY | O_NOFOLLOW);
+    if (dfd >= 0) remove_below_from_signal(dfd, 3);
+    rmdir(g_staging[i]);
+  }
+  g_nstaging = 0;
+}
+
+// the line gs_folder_abort_on_signals writes, and its length
+static char g_stop_line[256];
+static size_t g_stop_len = 0;
+
+// installed with SA_RESETHAND | SA_NODEFER: the signal raised again ends the process
+static void on_abort_signal(int sig) {
+  ssize_t w = write(2, g_stop_line, g_stop_len);
+  (void)w;
+  gs_folder_abort_from_signal();
+  raise(sig);
+  _exit(128 + sig);
+}
+
+int gs_folder_abort_on_signals(const char* line) {
+  static const int sigs[3] = {SIGINT, SIGTERM, SIGHUP};
+  struct sigaction old;
+  if (sigaction(SIGINT, NULL, &old) != 0) return -1;
+  if ((old.sa_flags & SA_SIGINFO) || (old.sa_handler != SIG_DFL && old.sa_handler != SIG_IGN))
+    return 0;  // the solver's stop signals (or another handler) are in place
+  g_stop_len = (size_t)snprintf(g_stop_line, sizeof(g_stop_line), "%s\n", line);
+  if (g_stop_len >= sizeof(g_stop_line)) g_stop_len = sizeof(g_stop_line) - 1;
+  struct sigaction sa;
+  memset(&sa, 0, sizeof(sa));
+  sa.sa_handler = on_abort_signal;
+  sa.sa_flags = SA_RESETHAND | SA_NODEFER;
+  sigemptyset(&sa.sa_mask);
+  for (int i = 0; i < 3; i++) sigaddset(&sa.sa_mask, sigs[i]);
+  for (int i = 0; i < 3; i++)
+    if (sigaction(sigs[i], &sa, NULL) != 0) return -1;
+  return 0;
 }

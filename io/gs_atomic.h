@@ -54,7 +54,7 @@ int gs_mkdir_p(const char* path, char* err, int errsz);
 // (renameat2 RENAME_EXCHANGE; on a file system without it, two renames with a moment in between
 // where the target is absent) after which the old folder is removed. A reader sees the old
 // complete folder or the new complete one, never a mix, and a failed run leaves neither an empty
-// folder nor old and new files side by side. One transaction is open at a time per process.
+// folder nor old and new files side by side.
 
 // A folder being written: write files into `staging`, then gs_folder_commit or gs_folder_abort.
 typedef struct gsFolderTx_ {
@@ -76,14 +76,31 @@ int gs_folder_begin(gsFolderTx* tx, const char* path, char* err, int errsz);
 // On failure the temporary folder is removed and path is as it was. Always releases tx.
 int gs_folder_commit(gsFolderTx* tx, char* err, int errsz);
 
+// For a single file at path written as a whole with its companions (e.g. a video and the
+// temporary files of its encoder): write it as staging/BASENAME (BASENAME: path's last
+// component), then this renames it over path and removes the temporary folder with whatever
+// else is in it. On failure the temporary folder is removed and path is as it was. Always
+// releases tx.
+int gs_folder_commit_file(gsFolderTx* tx, char* err, int errsz);
+
 // Remove the temporary folder (and parents this transaction created); path is untouched. Safe
 // on a zeroed or released tx.
 void gs_folder_abort(gsFolderTx* tx);
 
-// From a signal handler: remove the files of the open transaction's temporary folder and the
-// folder, with async-signal-safe calls only (open, getdents64, unlinkat). Nothing when no
-// transaction is open.
+// From a signal handler: remove the open transactions' temporary folders with everything in
+// them (three levels of folders deep: a sweep's folder holds its solves' folders), innermost
+// first, with async-signal-safe calls only (open, getdents64, unlinkat). Nothing when no
+// transaction is open. Up to 4 transactions may be open at once (nested: a sweep and its solve;
+// side by side: a video and its frames); only one of them is committed or aborted at a time.
 void gs_folder_abort_from_signal(void);
+
+// For a command that stops at once on a signal (render): SIGINT, SIGTERM and SIGHUP write
+// `line` (one line, newline added) on stderr, remove the open transactions' temporary folders
+// (gs_folder_abort_from_signal) and end the process by that signal (exit status 128 + signal
+// in a shell). Nothing when a SIGINT handler is already
+// installed (e.g. the solver's stop signals, go_ipopt_install_stop_signals, when `run` renders:
+// the render then completes and `run` stops after it). 0, or -1 when sigaction fails.
+int gs_folder_abort_on_signals(const char* line);
 
 // Remove path and everything below it (like rm -rf; symbolic links are removed, not followed).
 int gs_remove_tree(const char* path, char* err, int errsz);

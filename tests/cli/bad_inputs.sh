@@ -7,8 +7,10 @@
 # temporary folder left beside it. Then the faults: disk full on a small tmpfs (skipped loudly
 # when no tmpfs can be mounted), SIGINT, SIGTERM and SIGHUP in the middle of a planar solve
 # (exit 3, status "interrupted", the folder complete), two SIGTERMs (the process ends by the
-# signal, the earlier result untouched), SIGTERM to a sweep (both chains stop and write), a stale
-# folder, truncated and inconsistent files.
+# signal, the earlier result untouched), SIGTERM to a sweep (both chains stop and write what
+# finished in place of an earlier sweep; two: the earlier sweep untouched), SIGTERM to render
+# (nothing written, earlier frames untouched) and to simulate (the rows so far, exit 3; two: the
+# earlier result untouched), a stale folder, truncated and inconsistent files.
 # The solves use the planar model mjmodels/gait2d.xml (seconds).
 # usage: bad_inputs.sh GAITSIM SOURCE_DIR
 set -u
@@ -191,6 +193,21 @@ expect "track --init with a truncated states.sto" 1 '^gaitsim: trunc2/states\.st
   "$G" "${T[@]}" --init trunc2 --nodes 6 --max-iter 1
 expect "sweep --guess without summary.json" 1 '^gaitsim: nosummary: no summary\.json' keep \
   "$G" sweep --guess nosummary --speeds 1 --out keep --nodes 6 --max-iter 1
+# whole folders of sweep, run and render: an --out that is not an earlier result of the command
+expect "sweep --out a solution folder (not a sweep)" 1 '^gaitsim: keep: exists and holds no sweep\.csv' \
+  keep "$G" sweep --guess sol --speeds 1 --out keep --nodes 6 --max-iter 1
+mkdir -p notrun/sweep && echo "my notes" >notrun/sweep/notes.txt
+expect "run --out whose sweep/ is not a sweep (before any solve)" 1 \
+  '^gaitsim: notrun/sweep: exists and holds no sweep\.csv' notrun "$G" run --out notrun --no-video
+expect "render --frames into a folder of other files" 1 \
+  '^gaitsim: notmine: exists and holds no frame_00000\.png' notmine \
+  "$G" render sol --frames notmine --size 64x48
+# a sweep in which no speed is solved (the guess names no model, so predict meets the default
+# 3D model): the reason on stderr, --out (an earlier sweep) as it was
+mkdir -p sweep_keep && echo "speed_mps" >sweep_keep/sweep.csv && mkdir sweep_keep/predict_9
+cp -r sol nomodel && sed -i 's|"model":[^,]*|"model": "nowhere.xml"|' nomodel/summary.json
+expect "sweep in which no speed is solved" 1 '^gaitsim: sweep: 0\.5 m/s: nomodel/states\.sto: ' \
+  sweep_keep --solve "$G" sweep --guess nomodel --speeds 0.5 --out sweep_keep --nodes 6 --max-iter 1
 check "at least 40 cases ($cases)" test "$cases" -ge 40
 
 # --- disk full: a 32 kB tmpfs, in a private mount namespace where possible -----------------------
@@ -254,19 +271,26 @@ check "two SIGTERMs: the earlier result untouched" test "$before" = "$(snap twic
 check "two SIGTERMs: no temporary folder" no_tmp twice
 
 # sweep: one SIGTERM reaches both chains (the second process gets it from the first); each
-# writes its interrupted solve, no further speed starts, the table is written, exit 3
+# writes its interrupted solve, no further speed starts, the table is written, exit 3; the sweep
+# replaces an earlier one whole (its predict_V of another speed does not stay)
 read -r down1 down2 up1 up2 < <(/usr/bin/python3 -c '
 import json, sys; v = json.load(open(sys.argv[1]))["speed_mps"]
 print("%.2f %.2f %.2f %.2f" % (v - 0.3, v - 0.4, v + 0.3, v + 0.4))' sol/summary.json)
-"$gaitsim" sweep --guess sol --speeds "$down2,$down1,$up1,$up2" --out sw --nodes 10 \
-  --max-iter 3000 >sw.out 2>sw.err &
-pid=$!
-for i in $(seq 300); do
-  if [ "$(cat sw/*.log 2>/dev/null | grep -c '^iter    5 ')" -ge 2 ]; then break; fi
-  sleep 0.1
-done
-kill -TERM $pid
-wait $pid
+"$gaitsim" sweep --guess sol --speeds "$up2" --out sw --nodes 6 --max-iter 2 >/dev/null 2>&1
+check "earlier sweep: written" test -f sw/sweep.csv -a "$(ls -d sw/predict_* | wc -l)" -eq 1
+sweep_and_signal() {  # OUT SIGNAL [SIGNAL2]: a 4-speed sweep, signals once both chains iterate
+  "$gaitsim" sweep --guess sol --speeds "$down2,$down1,$up1,$up2" --out "$1" --nodes 10 \
+    --max-iter 3000 >"$1.out" 2>"$1.err" &
+  local pid=$! i
+  for i in $(seq 300); do  # the solves' progress: DIR's temporary folder, SPEED_DIR.log
+    if [ "$(cat ".$1".tmp.*/*.log 2>/dev/null | grep -c '^iter    5 ')" -ge 2 ]; then break; fi
+    sleep 0.1
+  done
+  kill -s "$2" $pid
+  if [ $# -ge 3 ]; then sleep 0.3; kill -s "$3" $pid; fi
+  wait $pid
+}
+sweep_and_signal sw TERM
 status=$?
 check "sweep SIGTERM: exit 3 (got $status)" test "$status" -eq 3
 for v in $down1 $up1; do
@@ -274,10 +298,80 @@ for v in $down1 $up1; do
   check "sweep SIGTERM: predict_$v interrupted and written" \
     grep -q '"status":[[:space:]]*"interrupted"' "sw/predict_$v/summary.json"
 done
-check "sweep SIGTERM: the further speeds not started ($(ls sw | tr '\n' ' '))" \
+check "sweep SIGTERM: only the 2 interrupted speeds, none of the earlier sweep ($(ls sw | tr '\n' ' '))" \
   test "$(ls -d sw/predict_* | wc -l)" -eq 2
 check "sweep SIGTERM: the table has the 4 speeds" test "$(($(wc -l <sw/sweep.csv) - 1))" -eq 4
-check "sweep SIGTERM: no temporary folder" no_tmp sw/x
+check "sweep SIGTERM: the table says 2 speeds were not solved" \
+  test "$(grep -c ',not solved$' sw/sweep.csv)" -eq 2
+check "sweep SIGTERM: no temporary folder in or beside sw" no_tmp sw/x
+check "sweep SIGTERM: no temporary folder" no_tmp sw
+# two SIGTERMs: both processes end at once, the earlier sweep stays as it was
+before=$(snap sw)
+sweep_and_signal sw TERM TERM
+status=$?
+check "sweep two SIGTERMs: ended by SIGTERM (status $status)" test "$status" -eq 143
+check "sweep two SIGTERMs: the earlier sweep untouched" test "$before" = "$(snap sw)"
+sleep 0.5  # the second process ends by its own second signal
+check "sweep two SIGTERMs: no temporary folder" no_tmp sw
+check "sweep two SIGTERMs: no process left" test -z "$(pgrep -f "sweep --guess sol --speeds $down2")"
+
+# render: --frames DIR is replaced whole (no stale frame stays); a signal stops render at once,
+# the earlier frames untouched, no temporary folder (no ffmpeg needed: frames only)
+"$gaitsim" render sol --frames frames --size 64x48 >render.out
+nframes=$(ls frames | wc -l)
+touch frames/frame_09999.png
+"$gaitsim" render sol --frames frames --size 64x48 >/dev/null
+check "render --frames: the stale frame is gone ($(ls frames | wc -l) files, $nframes at first)" \
+  test "$(ls frames | wc -l)" -eq "$nframes" -a ! -e frames/frame_09999.png
+check "render --frames: as many frames as it says ($nframes)" grep -q "frames: $nframes frames" render.out
+before=$(snap frames)
+"$gaitsim" render sol --frames frames --size 320x240 --cycles 100 >/dev/null 2>render.err &
+pid=$!
+for i in $(seq 100); do
+  if [ "$(ls .frames.tmp.*/ 2>/dev/null | wc -l)" -ge 5 ]; then break; fi
+  sleep 0.1
+done
+kill -TERM $pid
+wait $pid
+status=$?
+check "render SIGTERM: ended by SIGTERM (status $status)" test "$status" -eq 143
+check "render SIGTERM: one line (got: $(cat render.err))" \
+  one_gaitsim_line "$(cat render.err)" '^gaitsim: render: stopped by a signal; nothing written$' strict
+check "render SIGTERM: the earlier frames untouched" test "$before" = "$(snap frames)"
+check "render SIGTERM: no temporary folder" no_tmp frames
+
+# simulate: a signal ends the simulation at the next step, the rows so far written (exit 3); two
+# signals end it at once, the earlier result untouched
+"$gaitsim" simulate "$planar" --out simkeep --duration 0.1 --hold >/dev/null
+simulate_and_signal() {  # OUT DURATION RATE SIGNAL [SIGNAL2]: a long simulation, signalled
+  "$gaitsim" simulate "$planar" --out "$1" --duration "$2" --rate "$3" --hold >/dev/null \
+    2>"$1.err" &                                    # once begun
+  local pid=$! i
+  for i in $(seq 100); do
+    if ls -d ".$1".tmp.* >/dev/null 2>&1; then break; fi
+    sleep 0.1
+  done
+  sleep 0.5
+  kill -s "$4" $pid
+  if [ $# -ge 5 ]; then sleep 0.2; kill -s "$5" $pid; fi
+  wait $pid
+}
+simulate_and_signal sim_int 3600 100 INT
+status=$?
+check "simulate SIGINT: exit 3 (got $status)" test "$status" -eq 3
+check "simulate SIGINT: says where it stopped ($(grep '^gaitsim: simulate' sim_int.err))" \
+  grep -Eq '^gaitsim: simulate: stopped by a signal at t = [0-9.]+ s; writing the [0-9]+ rows' sim_int.err
+rows=$(grep -Eo 'writing the [0-9]+ rows' sim_int.err | grep -Eo '[0-9]+')
+check "simulate SIGINT: states.sto holds the ${rows:-?} rows (1..359999)" \
+  test "${rows:-0}" -ge 1 -a "${rows:-0}" -lt 360000 -a "$(grep -Ec '^-?[0-9]' sim_int/states.sto)" -eq "${rows:-0}"
+check "simulate SIGINT: no temporary folder" no_tmp sim_int
+before=$(snap simkeep)
+# (10^4 rows a second: writing the rows takes longer than the 0.2 s before the second signal)
+simulate_and_signal simkeep 100 1e4 TERM TERM
+status=$?
+check "simulate two SIGTERMs: ended by SIGTERM (status $status)" test "$status" -eq 143
+check "simulate two SIGTERMs: the earlier result untouched" test "$before" = "$(snap simkeep)"
+check "simulate two SIGTERMs: no temporary folder" no_tmp simkeep
 
 # a failed solve leaves no empty folder (the parents it would have made included)
 "$gaitsim" track nowhere --model "$planar" --out new/deeper/sol --threads 1 >/dev/null 2>&1

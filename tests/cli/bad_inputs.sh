@@ -287,7 +287,13 @@ sweep_and_signal() {  # OUT SIGNAL [SIGNAL2]: a 4-speed sweep, signals once both
     sleep 0.1
   done
   kill -s "$2" $pid
-  if [ $# -ge 3 ]; then sleep 0.3; kill -s "$3" $pid; fi
+  if [ $# -ge 3 ]; then  # the second signal as soon as the first has been taken (not a fixed
+    for i in $(seq 500); do  # delay: on a loaded machine the sweep could end within one)
+      if cat "$1.err" ".$1".tmp.*/*.log 2>/dev/null | grep -q 'stop signal'; then break; fi
+      sleep 0.01
+    done
+    kill -s "$3" $pid
+  fi
   wait $pid
 }
 sweep_and_signal sw TERM

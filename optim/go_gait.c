@@ -674,15 +674,23 @@ void go_gait_free(go_gait* g) {
 // (gs_physics.c), so the foot contact depends on heights alone. Those rows are then linear (zero)
 // in these coordinates and have no curvature in them; the moment rows (about the world origin)
 // are not, being r x F.
-static int horizontal_translation(const mjModel* m, int j);
+static int horizontal_translations(const mjModel* m, unsigned char* flat);
 static int build_elements(go_gait* g) {
   const go_gait_layout* L = &g->L;
   int nv = L->nv, na = L->na, ne = L->ne, E = 1 + ne + na;
-  int moments = L->ngrf > GO_GAIT_GRM_OFFSET;
+  unsigned char* flat = (unsigned char*)calloc((size_t)nv, 1);  // dofs left out (above)
+  if (!flat) return -1;
+  if (L->ngrf <= GO_GAIT_GRM_OFFSET && horizontal_translations(g->m, flat) != 0) {
+    free(flat);
+    return -1;
+  }
   int nrows = 2 * nv + 2 * 0 + nv + L->ngrf + ne + 2 * na;  // generous
   int nvars = (3 * nv + na + ne) + ne * (2 * nv + 3) + 2 * na;
   int* mem = (int*)malloc(sizeof(int) * (size_t)(2 * (E + 1) + nrows + nvars));
-  if (!mem) return -1;
+  if (!mem) {
+    free(flat);
+    return -1;
+  }
   int *row_ptr = mem, *var_ptr = mem + E + 1, *rows = var_ptr + E + 1, *vars = rows + nrows;
   int nr = 0, nvv = 0, e = 0;
   // dynamics
@@ -692,7 +700,8 @@ static int build_elements(go_gait* g) {
   for (int i = 0; L->r_fib >= 0 && i < na; i++)
     if (L->elastic_of[i] < 0) rows[nr++] = L->r_fib + i;
   for (int j = 0; j < nv; j++)
-    if (moments || !horizontal_translation(g->m, j)) vars[nvv++] = L->x_q + j;
+    if (!flat[j]) vars[nvv++] = L->x_q + j;
+  free(flat);
   for (int j = 0; j < nv; j++) vars[nvv++] = L->x_qd + j;
   for (int i = 0; i < na; i++)
     if (L->elastic_of[i] < 0) vars[nvv++] = L->x_a + i;
@@ -745,17 +754,21 @@ static int build_elements(go_gait* g) {
   return 0;
 }
 
-// 1 when dof j is a slide whose ancestors are all slides (so its axis is fixed in the world) and
-// whose axis is horizontal (perpendicular to the world z axis, the floor's normal, to 1e-9)
-static int horizontal_translation(const mjModel* m, int j) {
-  for (int a = j; a >= 0; a = m->dof_parentid[a])
-    if (m->jnt_type[m->dof_jntid[a]] != mjJNT_SLIDE) return 0;
+// flat[j] = 1 for every dof j that is a slide whose ancestors are all slides (so its axis is fixed
+// in the world) and whose axis is horizontal (perpendicular to the world z axis, the floor's
+// normal, to 1e-9), else 0 (nv). 0, or -1 out of memory.
+static int horizontal_translations(const mjModel* m, unsigned char* flat) {
   mjData* d = mj_makeData(m);
-  if (!d) return 0;
-  mj_kinematics(m, d);  // at qpos0; the axis does not depend on the slides' positions
-  double z = d->xaxis[3 * m->dof_jntid[j] + 2];
+  if (!d) return -1;
+  mj_kinematics(m, d);  // at qpos0; such axes do not depend on the slides' positions
+  for (int j = 0; j < m->nv; j++) {
+    int slides = 1;
+    for (int a = j; a >= 0 && slides; a = m->dof_parentid[a])
+      slides = m->jnt_type[m->dof_jntid[a]] == mjJNT_SLIDE;
+    flat[j] = slides && fabs(d->xaxis[3 * m->dof_jntid[j] + 2]) < 1e-9;
+  }
   mj_deleteData(d);
-  return fabs(z) < 1e-9;
+  return 0;
 }
 
 const go_elements* go_gait_elements(const go_gait* g) { return &g->el; }

@@ -53,7 +53,7 @@ typedef struct {
 } fd_read;
 
 typedef struct {
-  double *zs, *z, *g0, *gp, *gn, *gm, *gq, *mu, *J0, *J1, *J2;  // gp, gn: nf x np
+  double *zs, *z, *g0, *gp, *gn, *gq, *mu, *J0, *J1, *J2;  // gp, gn: nf x np
 } fd_scratch;
 
 typedef struct go_hess_fd {
@@ -608,7 +608,7 @@ int go_hess_create_fd(go_hess** out, go_nlp* nlp, const go_elements* el, char* e
   // per-worker scratch
   for (int w = 0; w < f->nthreads && !rc; w++) {
     fd_scratch* s = &f->ws[w];
-    size_t len = 2 * (size_t)nz + (size_t)np * (5 + 2 * (size_t)f->nf) + 3 * (size_t)nlp->nnz_p;
+    size_t len = 2 * (size_t)nz + (size_t)np * (3 + 2 * (size_t)f->nf) + 3 * (size_t)nlp->nnz_p;
     s->zs = malloc(sizeof(double) * (len + 1));
     if (!s->zs) {
       rc = fail(err, errsz, "out of memory (finite-difference Hessian)", 4);
@@ -616,8 +616,7 @@ int go_hess_create_fd(go_hess** out, go_nlp* nlp, const go_elements* el, char* e
     }
     s->z = s->zs + nz;
     s->g0 = s->z + nz;
-    s->gm = s->g0 + np;
-    s->gq = s->gm + np;
+    s->gq = s->g0 + np;
     s->mu = s->gq + np;
     s->J0 = s->mu + np;
     s->J1 = s->J0 + nlp->nnz_p;

@@ -16,9 +16,9 @@
 // beats any more violated one; non-finite values never win. So a nearly feasible iterate that
 // a later, slightly more violated one beats by a wide margin is not kept (a tracking solve on
 // another trial kept objective 32.9 at its least violated iterate against 3.8 reached later at
-// a violation of 6e-4). The final point Ipopt returns is scored as well. Limits: in the restoration phase the
-// iterates are those of the restoration problem (their x part is scored, which is fine); a point
-// whose Jacobian evaluation failed is never scored.
+// a violation of 6e-4). The final point Ipopt returns is scored as well. Limits: in the
+// restoration phase the iterates are those of the restoration problem (their x part is scored,
+// which is fine); a point whose Jacobian evaluation failed is never scored.
 #ifndef GAITSIM_OPTIM_GO_IPOPT_H_
 #define GAITSIM_OPTIM_GO_IPOPT_H_
 

@@ -93,13 +93,12 @@ int go_hess_values(go_hess* h, const double* x, double obj_factor, const double*
 // objective adds its exact diagonal (go_nlp_eval_hess_diag) when the problem has one; otherwise
 // the objective's curvature is left out. With a free T the defects' T x xdot curvature is left out.
 // Rows in no element are taken as linear. Same arguments and results as go_hess_create.
-// Measured 2026-12-01 (`gaitsim track ... --nodes 20 --hessian exact`, 2 shared cores): 8655
-// Hessian entries per node, about 1800 path evaluations per node and Hessian, 2-4.4 s per
-// iteration against 0.4 s with L-BFGS; Ipopt takes tiny steps (alpha 1e-3 - 1e-1, mu stays at
-// 0.1) and inf_du grows to 1e5-1e9 within 30 iterations, before and after the tendon fix of
-// mjmodels/README.md rule 3 (its values are right: tests/test_hessian_fd.c). That was Ipopt's
-// monotone barrier from mu 0.1; from an L-BFGS tracking solution with mu 1e-6 and mu-based bound
-// multipliers it reaches Ipopt's acceptable level in 78 iterations (2026-12-02, docs/BENCHMARKS.md),
+// Measured (docs/BENCHMARKS.md, "Resolution"): 8468 Hessian entries per node of jw_fullbody and
+// about 910 path evaluations per node and Hessian (tests/test_hessian_fd.c prints both); at N = 80
+// about 3.4 s of CPU per Hessian. From the trial's guess with Ipopt's monotone barrier from mu 0.1
+// the steps are tiny (alpha 1e-3 - 1e-1) and inf_du grows to 1e5-1e9 within 30 iterations (the
+// values are right: tests/test_hessian_fd.c); from an L-BFGS tracking solution with mu 1e-6 and
+// mu-based bound multipliers it reaches Ipopt's acceptable level in about 50 iterations at N = 20,
 // which `gaitsim track --refine` uses after an L-BFGS solve that stops short.
 int go_hess_create_fd(go_hess** out, go_nlp* nlp, const go_elements* el, char* err, int errsz);
 

@@ -1,0 +1,187 @@
+#!/usr/bin/python3
+"""docs/VALIDATION.md from a main job's results: the project's figures against measurement.
+
+usage: scripts/validation.py [RESULTS] > docs/VALIDATION.md
+
+RESULTS (default results) is the folder `gaitsim run` writes: RESULTS/track (the tracking solve of
+mjmodels/trials/jw_ngait_og5) and the predictions RESULTS/sweep/predict_* (or RESULTS/predict_*).
+Every figure is read from the solution files (summary.json, grf.mot, controls.sto) and set
+beside its reference: the paper's Table 1 for participant 2 (JW) and its predicted and measured
+stride times (Lin, Walter & Pandy 2018, Ann Biomed Eng 46:1216), the in-vivo knee contact force of
+the instrumented implant (eTibia; Fregly et al. 2012, J Orthop Res 30:503) as each trial folder
+holds it (knee_contact.sto), the measured centres of pressure of the trial (grf.mot), and
+Ralston's energy-speed relation for level walking (Ralston 1958, Int Z Angew Physiol 17:277:
+gross metabolic rate 29 + 0.0053 v^2 cal/(kg min), v in m/min). The targets are those of the
+project's issues (#19 resolution, #20 physiology). Exit 1 with one line naming the file when an
+input is missing.
+"""
+import glob
+import json
+import math
+import os
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from gs_scriptlib import PrepError, read_storage  # noqa: E402
+
+CAL = 4.184             # J per cal
+BASAL_W_PER_KG = 1.2    # basal rate added to the model's muscle power for its gross cost (W/kg)
+PAPER_T1_P2 = {         # Lin, Walter & Pandy 2018, Table 1, participant 2 (JW)
+    "pelvis_rot_deg": 0.21, "pelvis_trans_cm": 0.20, "grf_ap_bw": 0.02, "grf_v_bw": 0.04,
+    "grf_ml_bw": 0.02, "joint_rot_deg": 1.98, "knee_contact_bw": 0.32}
+PAPER_STRIDE = {0.8: (1.30, 1.45), 2.0: (0.92, 0.93)}  # speed: (predicted, measured mean) (s)
+KNEE_PEAK_LIMIT = {0.8: 2.8, 2.0: 3.5}                 # issue #20 item 5 (BW)
+
+
+def ralston_gross_w_per_kg(v):
+    """Ralston 1958: gross metabolic rate of level walking at v (m/s), W/kg."""
+    vm = 60.0 * v
+    return (29.0 + 0.0053 * vm * vm) * CAL / 60.0
+
+
+def load_summary(folder):
+    path = os.path.join(folder, "summary.json")
+    try:
+        with open(path, encoding="utf-8") as f:
+            return json.load(f)
+    except (OSError, ValueError) as e:
+        raise PrepError(path, getattr(e, "strerror", None) or str(e))
+
+
+def stance_cop_z(path):
+    """Force-weighted mean mediolateral centre of pressure (m) of each foot over its stance
+    (vertical force > 20 N): where each foot stands, from grf.mot."""
+    _, labels, rows = read_storage(path)
+    out = {}
+    for side in "rl":
+        try:
+            fy, pz = labels.index(f"ground_force_{side}_vy"), labels.index(f"ground_force_{side}_pz")
+        except ValueError:
+            raise PrepError(path, f"no ground_force_{side}_vy / _pz columns")
+        w = [(r[fy], r[pz]) for r in rows if r[fy] > 20.0]
+        if not w:
+            raise PrepError(path, f"foot {side}: never loaded above 20 N")
+        out[side] = sum(f * z for f, z in w) / sum(f for f, _ in w)
+    return out
+
+
+def fmt(v, digits=2):
+    return "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else f"{v:.{digits}f}"
+
+
+def row(cells):
+    print("| " + " | ".join(cells) + " |")
+
+
+def tracking(track):
+    s = load_summary(track)
+    rms = s.get("rms", {})
+    trial = s.get("trial", "")
+    print(f"## Tracking: {trial}, {s.get('nodes')} nodes ({s.get('status')})\n")
+    print("Model RMS errors over the stride against the trial; the paper's Table 1 for the same "
+          "participant (JW) beside them. Target (#20 item 6): every Table 1 figure met or beaten "
+          "while knee contact stays <= 0.30 BW.\n")
+    row(["figure", "model", "paper (Table 1, participant 2)", "met"])
+    row(["---"] * 4)
+    names = [("pelvis_rot_deg", "pelvis rotations (deg)"), ("pelvis_trans_cm", "pelvis translations (cm)"),
+             ("grf_ap_bw", "GRF fore-aft (BW)"), ("grf_v_bw", "GRF vertical (BW)"),
+             ("grf_ml_bw", "GRF mediolateral (BW)"), ("joint_rot_deg", "other joint rotations (deg)"),
+             ("knee_contact_bw", "knee contact force, total (BW)")]
+    for key, label in names:
+        v, ref = rms.get(key), PAPER_T1_P2[key]
+        row([label, fmt(v, 3), fmt(ref), "yes" if v is not None and v <= ref else "no"])
+    print()
+    print("Knee contact against the implant's in-vivo measurement (eTibia, the trial's "
+          "knee_contact.sto). Targets (#20 item 3): medial and lateral RMS each <= 0.30 BW, total "
+          "<= 0.25 BW.\n")
+    row(["compartment", "RMS error (BW)", "target (BW)", "met"])
+    row(["---"] * 4)
+    for key, label, tgt in (("knee_contact_bw", "total", 0.25), ("knee_medial_bw", "medial", 0.30),
+                            ("knee_lateral_bw", "lateral", 0.30)):
+        v = rms.get(key)
+        row([label, fmt(v, 3), fmt(tgt), "yes" if v is not None and v <= tgt else "no"])
+    print()
+    if trial and os.path.isfile(os.path.join(trial, "grf.mot")):
+        m = stance_cop_z(os.path.join(trial, "grf.mot"))
+        p = stance_cop_z(os.path.join(track, "grf.mot"))
+        wm, wp = 100 * (m["r"] - m["l"]), 100 * (p["r"] - p["l"])
+        print("Stance width: the mediolateral distance between the feet, each foot's "
+              "force-weighted mean centre of pressure over its stance (grf.mot). Target (#20 "
+              "item 2): within 3 cm of the measured one.\n")
+        row(["", "model", "measured", "difference", "met"])
+        row(["---"] * 5)
+        row(["stance width (cm)", fmt(wp, 1), fmt(wm, 1), f"{wp - wm:+.1f}",
+             "yes" if abs(wp - wm) <= 3 else "no"])
+        print()
+
+
+def predictions(folders):
+    sums = []
+    for f in folders:
+        s = load_summary(f)
+        if s.get("problem") == "prediction":
+            sums.append(s)
+    if not sums:
+        return
+    sums.sort(key=lambda s: s.get("speed_target_mps", 0))
+    print(f"## Predictions: minimum cost of transport, free stride time\n")
+    print("Stride time against the paper's predicted and JW's measured means (target, #20 item 4: "
+          "within 5 % of the measured). Net cost: the model's muscles (smooth Umberger 2010); "
+          f"gross: plus a basal {BASAL_W_PER_KG} W/kg, against Ralston 1958's gross rate "
+          "(target: within 25 %). Peak knee contact of either knee (targets, #20 item 5: <= 2.8 BW "
+          "at 0.8 m/s, <= 3.5 BW at 2.0 m/s).\n")
+    row(["speed (m/s)", "nodes, status", "stride (s)", "paper predicted / measured (s)",
+         "net CoT (J/(kg m))", "net power (W/kg)", "gross power (W/kg)", "Ralston gross (W/kg)",
+         "gross within 25 %", "peak knee contact r / l (BW)", "knee within limit"])
+    row(["---"] * 11)
+    for s in sums:
+        v = s.get("speed_target_mps")
+        T = s.get("stride_time_s")
+        ref = PAPER_STRIDE.get(round(v, 1) if v else None)
+        cot = s.get("cost_of_transport_j_per_kg_m")
+        net = cot * v if cot is not None and v else None
+        gross = net + BASAL_W_PER_KG if net is not None else None
+        ral = ralston_gross_w_per_kg(v) if v else None
+        kr, kl = s.get("peak_knee_contact_r_bw"), s.get("peak_knee_contact_l_bw")
+        lim = KNEE_PEAK_LIMIT.get(round(v, 1) if v else None)
+        row([fmt(v, 1), f"{s.get('nodes')}, {s.get('status')}",
+             fmt(T, 3) + (f" ({100 * (T / ref[1] - 1):+.1f} % of measured)" if ref and T else ""),
+             f"{ref[0]:.2f} / {ref[1]:.2f}" if ref else "-", fmt(cot), fmt(net), fmt(gross), fmt(ral),
+             "yes" if gross is not None and abs(gross / ral - 1) <= 0.25 else "no",
+             f"{fmt(kr)} / {fmt(kl)}",
+             "-" if lim is None else ("yes" if max(kr, kl) <= lim else "no")])
+    print()
+    by = {round(s.get("speed_target_mps", 0), 1): s for s in sums}
+    if 0.8 in by and 2.0 in by:
+        pe0, pe1 = by[0.8].get("peak_excitation", {}), by[2.0].get("peak_excitation", {})
+        parts = []
+        for m in ("soleus", "gasmed", "gaslat"):
+            if pe0.get(m) and pe1.get(m):
+                parts.append(f"{m} {pe1[m] / pe0[m]:.2f}")
+        print("Fast/slow peak excitation ratio (2.0 against 0.8 m/s, right leg): "
+              f"{', '.join(parts) or '-'} (paper: about 2.5 for soleus and gastrocnemius).\n")
+
+
+def main(argv):
+    results = argv[1] if len(argv) > 1 else "results"
+    if len(argv) > 2 or results in ("-h", "--help"):
+        print(__doc__.split("\n\n")[1], file=sys.stderr)
+        return 2
+    try:
+        print("# Validation: the model's figures against measurement\n")
+        print(f"Generated by `scripts/validation.py {results} > docs/VALIDATION.md` from the "
+              "solutions of `gaitsim run` (`scripts/setup.sh && build/gaitsim run`, which writes "
+              f"{results}/). Regenerate both to check. References are cited in "
+              "scripts/validation.py's header.\n")
+        tracking(os.path.join(results, "track"))
+        preds = sorted(glob.glob(os.path.join(results, "sweep", "predict_*")) +
+                       glob.glob(os.path.join(results, "predict_*")))
+        predictions(preds)
+    except PrepError as e:
+        print(f"validation: {e}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))

@@ -1,0 +1,56 @@
+#!/usr/bin/env bash
+# scripts/validation.py (docs/VALIDATION.md's generator) on a synthetic results folder: a trial
+# whose feet stand at z = 0.25 / 0.10 m and a tracking solution at 0.30 / 0.05 m (stance width
+# 15.0 against 25.0 cm: +10.0, missed); Table 1 rows compared with the paper's participant 2;
+# predictions at 0.8 and 2.0 m/s with Ralston's gross rate (29 + 0.0053 v^2 cal/(kg min), v in
+# m/min: 2.87 and 7.34 W/kg) and the fast/slow soleus ratio (0.6 / 0.3 = 2.00); a missing
+# track summary exits 1 with one line naming the file.
+# usage: validation.sh GAITSIM SOURCE_DIR
+set -u
+src=$2
+source "$(dirname "$0")/../cli_common.bash"
+
+/usr/bin/python3 - <<'PY'
+import json, os
+def grf(path, zr, zl):
+    with open(path, "w") as f:
+        f.write("grf\nendheader\ntime\tground_force_r_vy\tground_force_r_pz\tground_force_l_vy\tground_force_l_pz\n")
+        for k in range(10):  # right foot loaded in rows 0-4, left in 5-9
+            f.write(f"{0.1 * k}\t{500 if k < 5 else 0}\t{zr}\t{0 if k < 5 else 500}\t{zl}\n")
+os.makedirs("trial"); os.makedirs("results/track")
+grf("trial/grf.mot", 0.25, 0.10)
+grf("results/track/grf.mot", 0.30, 0.05)
+json.dump({"problem": "tracking", "trial": "trial", "nodes": 80, "status": "optimal solution found",
+           "rms": {"pelvis_rot_deg": 0.2, "pelvis_trans_cm": 0.3, "grf_ap_bw": 0.02, "grf_v_bw": 0.01,
+                   "grf_ml_bw": 0.03, "joint_rot_deg": 2.5, "knee_contact_bw": 0.24,
+                   "knee_medial_bw": 0.29, "knee_lateral_bw": 0.31}},
+          open("results/track/summary.json", "w"))
+for v, T, cot, kr, kl, sol in ((0.8, 1.40, 2.5, 2.7, 2.9, 0.3), (2.0, 0.95, 3.5, 3.0, 3.2, 0.6)):
+    d = f"results/sweep/predict_{v:g}"
+    os.makedirs(d)
+    json.dump({"problem": "prediction", "speed_target_mps": v, "nodes": 80,
+               "status": "optimal solution found", "stride_time_s": T,
+               "cost_of_transport_j_per_kg_m": cot, "peak_knee_contact_r_bw": kr,
+               "peak_knee_contact_l_bw": kl, "peak_excitation": {"soleus": sol}},
+              open(os.path.join(d, "summary.json"), "w"))
+PY
+out=$(/usr/bin/python3 "$src/scripts/validation.py" results)
+status=$?
+check "exit 0 (got $status)" test "$status" -eq 0
+check "stance width 15.0 vs 25.0, missed" grep -qF "| stance width (cm) | 25.0 | 15.0 | +10.0 | no |" <<<"$out"
+check "pelvis rotations beat the paper" grep -qF "| pelvis rotations (deg) | 0.200 | 0.21 | yes |" <<<"$out"
+check "joints miss the paper" grep -qF "| other joint rotations (deg) | 2.500 | 1.98 | no |" <<<"$out"
+check "lateral compartment missed" grep -qF "| lateral | 0.310 | 0.30 | no |" <<<"$out"
+# 0.8 m/s: net 2.5 x 0.8 = 2.00 W/kg, gross 3.20 against Ralston 2.87 (+11 %: within 25 %);
+# stride 1.40 against the measured 1.45 (-3.4 %); knee 2.9 > 2.8
+check "0.8 m/s row" grep -qF "| 0.8 | 80, optimal solution found | 1.400 (-3.4 % of measured) | 1.30 / 1.45 | 2.50 | 2.00 | 3.20 | 2.87 | yes | 2.70 / 2.90 | no |" <<<"$out"
+# 2.0 m/s: net 7.00, gross 8.20 against 7.34 (+12 %)
+check "2.0 m/s row" grep -qF "| 2.0 | 80, optimal solution found | 0.950 (+2.2 % of measured) | 0.92 / 0.93 | 3.50 | 7.00 | 8.20 | 7.34 | yes | 3.00 / 3.20 | yes |" <<<"$out"
+check "soleus ratio 2.00" grep -qF "soleus 2.00" <<<"$out"
+
+rm results/track/summary.json
+err=$(/usr/bin/python3 "$src/scripts/validation.py" results 2>&1 >/dev/null)
+status=$?
+check "missing summary: exit 1 (got $status)" test "$status" -eq 1
+check "missing summary: one line naming it" test "$err" = "validation: results/track/summary.json: No such file or directory"
+finish

@@ -11,6 +11,7 @@
 #include "callbacks/gs_model_info.h"
 #include "callbacks/gs_muscle.h"
 #include "callbacks/gs_physics.h"
+#include "optim/go_defaults.h"
 #include "optim/go_jacobian.h"
 
 // variable scales (physical units per solver unit)
@@ -96,7 +97,7 @@ struct go_gait {
 
 void go_gait_opts_default(go_gait_opts* o) {
   memset(o, 0, sizeof(*o));
-  o->N = 40;
+  o->N = GO_NODES_TRACK;
   o->nthreads = 1;
   o->w_pelvis_rot = 1.0;
   o->w_pelvis_trans = 1.0;
@@ -114,6 +115,7 @@ go_nlp* go_gait_nlp(go_gait* g) { return g->nlp; }
 const go_gait_layout* go_gait_layout_get(const go_gait* g) { return &g->L; }
 const mjModel* go_gait_model(const go_gait* g) { return g->m; }
 int go_gait_nodes(const go_gait* g) { return g->N; }
+int go_gait_threads(const go_gait* g) { return g->nthreads; }
 double go_gait_stride_time(const go_gait* g) { return g->T; }
 double go_gait_weight(const go_gait* g) { return g->weight; }
 double go_gait_q_ref(const go_gait* g, int k, int j) { return g->q_ref[k * g->L.nv + j]; }

@@ -16,8 +16,12 @@
 //      its violation is lower.
 // Progress (one line per Ipopt iteration, one per stage, the largest violation and multiplier
 // per constraint block) goes to plan.progress, each stage line prefixed with plan.label.
-// A further stage in front of the main solve (e.g. mesh continuation over coarser levels) adds
-// its settings to go_solve_plan and its figures to go_solve_report, as the stages above do.
+// A further stage in front of the main solve adds its settings to go_solve_plan and its figures
+// to go_solve_report, as the stages above do. Mesh continuation (e.g. 20 -> 40 -> 80 nodes) would
+// add the node counts of the coarser levels and what builds a problem at another node count (the
+// model and the go_gait_opts behind gait), solve each level with the stages below, and carry its
+// point onto the next mesh (go_refine_trapezoid) as that level's start, the last one onto gait's
+// mesh in place of z0; the report would gain one entry per level.
 #ifndef GAITSIM_OPTIM_GO_SOLVE_H_
 #define GAITSIM_OPTIM_GO_SOLVE_H_
 
@@ -58,9 +62,11 @@ typedef struct {
   go_hessian_kind hessian;    // Hessian of the main solve
   int max_iter;               // Ipopt iterations of the main solve and its restarts together
                               // (-); < 0: Ipopt's default
-  double max_wall_s;          // wall-clock limit of every stage together, counted per stage
-                              // from the solves before it (s); <= 0: none
-  int max_restarts;           // restarts after a fall-back, at most (-)
+  double max_wall_s;          // wall-clock limit (s); <= 0: none. The main solve and its
+                              // restarts share it, the refinement gets what they left (at most
+                              // refine_wall_s), the polish gets it whole
+  int max_restarts;           // restarts after a fall-back, at most (-; GO_MAX_RESTARTS at
+                              // most, the size of go_solve_report.restarts)
   int refine_iter;            // refinement's Newton iterations at most (-); 0: no refinement
   double refine_wall_s;       // refinement's wall-clock cap (s), or less when max_wall_s says
   int polish;                 // 1: feasibility polish of the point chosen

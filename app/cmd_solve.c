@@ -60,8 +60,11 @@ static const char* kTrackUsage =
     "                      (partitioned quasi-Newton, SR1 per node element; experimental),\n"
     "                      gauss-newton (exact for the tracking squares, constraints left out)\n"
     "                      or exact (the Lagrangian's Hessian by structured finite differences)\n"
-    "  --weight NAME=W     goal weight, NAME one of pelvis_rot (default 10), pelvis_trans (10),\n"
-    "                      joint (1), grf (10), grm (0), effort (50), accel (0) (repeatable);\n"
+    "  --weight NAME=W     goal weight, NAME one of pelvis_rot (default "
+    GO_STR(GO_TRACK_W_PELVIS_ROT) "), pelvis_trans (" GO_STR(GO_TRACK_W_PELVIS_TRANS) "),\n"
+    "                      joint (" GO_STR(GO_TRACK_W_JOINT) "), grf (" GO_STR(GO_TRACK_W_GRF)
+    "), grm (" GO_STR(GO_TRACK_W_GRM) "), effort (" GO_STR(GO_TRACK_W_EFFORT) "), accel ("
+    GO_STR(GO_TRACK_W_ACCEL) ") (repeatable);\n"
     "                      grm: the ground reaction moment about the origin (centre of pressure\n"
     "                      x force, so the feet's placement); each tracking group is a mean of\n"
     "                      squared errors over 5 deg, 2 cm, 0.1 BW or 0.1 BW x 0.1 m;\n"
@@ -141,12 +144,13 @@ static void defaults(gsTrackOptions* o) {
   go_solve_plan_default(&o->plan);
   o->plan.max_iter = GO_MAX_ITER;
   o->plan.progress = stderr;
-  o->w_pelvis_rot = o->w_pelvis_trans = o->w_grf = 10.0;
-  o->w_grm = 0.0;      // off: 10 narrows the stance to the measured one but, at 600 iterations,
-                       // worsens pelvis, GRF and knee tracking (docs/BENCHMARKS.md, 2026-12-02)
-  o->w_joint = 1.0;
-  o->w_effort = 50.0;  // 0.1 left mean activation at 0.37 (co-contraction); issue #6 note
-  o->w_accel = 0.0;    // tracking: none (results stay as they were); predict: PREDICT_W_ACCEL
+  o->w_pelvis_rot = GO_TRACK_W_PELVIS_ROT;
+  o->w_pelvis_trans = GO_TRACK_W_PELVIS_TRANS;
+  o->w_grf = GO_TRACK_W_GRF;
+  o->w_grm = GO_TRACK_W_GRM;
+  o->w_joint = GO_TRACK_W_JOINT;
+  o->w_effort = GO_TRACK_W_EFFORT;
+  o->w_accel = GO_TRACK_W_ACCEL;  // predict: GO_PREDICT_W_ACCEL
   o->fibre_bounds = 0; // tracking: none; predict: on (--no-fibre-bounds)
   o->metabolic_smoothing = 1.0;
   o->plan.label = "track";  // the refinement: tracking only; predict turns it off
@@ -667,25 +671,6 @@ static char* trial_of_solution(const char* dir) {
 #define PREDICT_BAND_TRANS 0.05       // m
 #define PREDICT_BAND_ROT_SPEED 6.0    // rad/s
 #define PREDICT_BAND_TRANS_SPEED 1.0  // m/s
-// default acceleration goal weight of predict (-): at the tracking solution results/track (peak
-// |qddot| 500 rad/s^2, the variable bound) the goal is 0.26 against J = 178; after 40 iterations
-// at 0.8 m/s (polished) it cut RMS qddot from 62 to 45 and the peak from 353 to 183 rad/s^2 at
-// 0.06 % of J (1: 23 and 113, 0.13 %); small enough not to move the cost of transport
-#define PREDICT_W_ACCEL 0.1
-// default factor on the smooth Umberger 2010 widths of predict (-): with the widths of
-// gs_umberger_smoothing_default (steps 0.01 wide in u - a, lM~ - 1 and v~ in lopt/s) no full-body
-// prediction reached Ipopt's stopping test in up to 1500 L-BFGS iterations; 10 times wider, 0.8
-// m/s reached the acceptable level after 477 and 2.0 m/s the optimal solution after 993 from the
-// same tracking solution, and the exact (unsmoothed) cost of transport of the solution differs by
-// 1.8 % (docs/BENCHMARKS.md, 2026-12-02); 3 times wider did not converge in 1000 at 0.8 m/s
-#define PREDICT_METABOLIC_SMOOTHING 10.0
-// predict's floor on the summed vertical ground reaction of both feet at every node (BW): no
-// flight phase. Not in the paper; without it, 20-node solves at 2.0 m/s found a gait with 2 of
-// 20 nodes in flight (2.5 BW peaks) and a bouncing one with flight at 3 nodes and a 75 % longer
-// stride, cheaper than the walks; with it the same guess gave a walk (double support at 2 nodes,
-// lowest summed force 0.22 BW). Human walking keeps it above about 0.4 BW even at 2 m/s
-// (docs/BENCHMARKS.md, "Walking: a floor on the vertical ground reaction")
-#define PREDICT_MIN_VGRF 0.2
 static int predict_setup(const mjModel* m, gsTrackOptions* o, go_gait_opts* go, double** band,
                          double* T0, double* dx0) {
   gsTable states, controls;
@@ -861,15 +846,18 @@ static const char* kPredictUsage =
     "  --max-iter N        Ipopt iteration limit (default " GO_STR(GO_MAX_ITER) ")\n"
     "  --max-time S        wall-clock limit, s (default none)\n"
     "  --weight NAME=W     regularisation weight: effort, the mean squared excitation (default\n"
-    "                      0.01); accel, the mean over all coordinates of (qddot / 50 rad/s^2\n"
-    "                      or m/s^2)^2 (default 0.1, a smoothness term; objective_share in\n"
+    "                      " GO_STR(GO_PREDICT_W_EFFORT)
+    "); accel, the mean over all coordinates of (qddot / 50 rad/s^2\n"
+    "                      or m/s^2)^2 (default " GO_STR(GO_PREDICT_W_ACCEL)
+    ", a smoothness term; objective_share in\n"
     "                      summary.json gives its fraction of J) (repeatable)\n"
     "  --no-fibre-bounds   no path bounds 0.25 <= lM/lopt <= 1.5 on every muscle's normalised\n"
     "                      fibre length (Lin, Walter & Pandy 2018, eq. 2; on by default; the\n"
     "                      guess's count outside them is printed)\n"
     "  --min-vgrf F        walking: the summed vertical ground reaction of both feet at least F\n"
     "                      body weights at every node, so no node is in flight (not in the\n"
-    "                      paper; default 0.2, 0 turns it off; summary.json min_summed_vgrf_bw,\n"
+    "                      paper; default " GO_STR(GO_PREDICT_MIN_VGRF)
+    ", 0 turns it off; summary.json min_summed_vgrf_bw,\n"
     "                      flight_nodes, double_support_nodes tell a walk from a run)\n"
     "  --stride-time S     hold the stride time at S seconds (0.4-2.5) instead of leaving it\n"
     "                      free: the cost of transport at a prescribed cadence\n"
@@ -877,7 +865,8 @@ static const char* kPredictUsage =
     "                      guess's): where the solve starts, not a bound\n"
     "  --metabolic-smoothing F  factor on every width of the smooth Umberger 2010 rates\n"
     "                      (steps in u - a, lM~ - 1 and v~, the maxima and minima; widths of\n"
-    "                      gs_metabolics.h times F; default 10: steps 0.1 wide, which lets the\n"
+    "                      gs_metabolics.h times F; default " GO_STR(GO_PREDICT_METABOLIC_SMOOTHING)
+    ": steps 0.1 wide, which lets the\n"
     "                      solves converge; summary.json gives the exact cost of transport too)\n"
     "  --no-polish         no feasibility polish of a solve that stopped short\n"
     "  --fallback-rise F   stop when the objective rises by more than the fraction F above the\n"
@@ -908,11 +897,11 @@ int gs_cmd_predict(int argc, char** argv) {
   o.plan.label = "predict";
   o.plan.refine_iter = 0;  // the exact Hessian leaves out the cost of transport's curvature
   o.nodes = GO_NODES_PREDICT;
-  o.w_effort = 0.01;
-  o.w_accel = PREDICT_W_ACCEL;
-  o.metabolic_smoothing = PREDICT_METABOLIC_SMOOTHING;
+  o.w_effort = GO_PREDICT_W_EFFORT;
+  o.w_accel = GO_PREDICT_W_ACCEL;
+  o.metabolic_smoothing = GO_PREDICT_METABOLIC_SMOOTHING;
   o.fibre_bounds = 1;
-  o.min_vgrf = PREDICT_MIN_VGRF;
+  o.min_vgrf = GO_PREDICT_MIN_VGRF;
   optind = 1;
   opterr = 0;
   int c, bad = 0, model_given = 0;

@@ -14,6 +14,7 @@
 #include "app/gs_commands.h"
 #include "app/gs_options.h"
 #include "io/gs_atomic.h"
+#include "optim/go_defaults.h"
 #include "optim/go_ipopt.h"
 
 static const char* kRunUsage =
@@ -23,8 +24,10 @@ static const char* kRunUsage =
     "The default job on the bundled model and trial (mjmodels/jw_fullbody_knee6.xml, the\n"
     "six-DOF implant knee with surrogate contact, and mjmodels/trials/jw_ngait_og5, or the\n"
     "trial folder of --trial, e.g. mjmodels/trials/jw_bouncy7):\n"
-    "  1. DIR/track: tracking solve on N nodes (default 20; more nodes are solved on 20 first and\n"
-    "     continued): up to 600 L-BFGS iterations; if they stop short, up to 150 Newton\n"
+    "  1. DIR/track: tracking solve on N nodes (default " GO_STR(GO_NODES_MAIN_JOB)
+    "; more nodes are solved on " GO_STR(GO_NODES_MAIN_JOB) " first and\n"
+    "     continued): up to " GO_STR(GO_MAX_ITER_MAIN_TRACK) " L-BFGS iterations; if they stop "
+    "short, up to " GO_STR(GO_REFINE_ITER) " Newton\n"
     "     iterations with the exact Hessian (gaitsim track --refine); polished to a dynamically\n"
     "     consistent point;\n"
     "  2. DIR/sweep/predict_V: predictive solves at the speeds of LIST (default 0.8,2.0: 0.8 and\n"
@@ -39,13 +42,15 @@ static const char* kRunUsage =
     "stopped short (its best iterate written), else as the failing step.\n\n"
     "  --trial DIR    the trial folder to track (coordinates.mot, grf.mot, knee_contact.sto;\n"
     "                 scripts/prepare_trial.py makes one; default mjmodels/trials/jw_ngait_og5)\n"
-    "  --max-iter N   Ipopt iteration limit of each predictive solve (default 1500: an iteration\n"
+    "  --max-iter N   Ipopt iteration limit of each predictive solve (default "
+    GO_STR(GO_MAX_ITER_SWEEP) ": an iteration\n"
     "                 budget, not a time limit, so that the results do not depend on the load\n"
     "                 of the machine; in the measured main jobs (docs/BENCHMARKS.md) they\n"
     "                 reached Ipopt's acceptable level after 419-865 (0.8 m/s) and 481-860\n"
     "                 (2.0 m/s) iterations, 6-13 minutes, on 2 cores)\n"
     "  --max-time S   wall-clock limit of each predictive solve, s (default none); the tracking\n"
-    "                 solve stops after 600 iterations (1000 on a continued mesh)\n";
+    "                 solve stops after " GO_STR(GO_MAX_ITER_MAIN_TRACK) " iterations ("
+    GO_STR(GO_MAX_ITER_MAIN_CONTINUED) " on a continued mesh)\n";
 
 // run one subcommand with the given words (argv[0] is the subcommand)
 static int sub(gsCommandFn fn, const char* const* words) {
@@ -88,8 +93,8 @@ int gs_cmd_run(int argc, char** argv) {
       {"speeds", required_argument, NULL, 's'},   {"no-video", no_argument, NULL, 'V'},
       {"trial", required_argument, NULL, 'r'},    {"help", no_argument, NULL, 'h'},
       {NULL, 0, NULL, 0}};
-  const char *out = "results", *nodes = "20", *threads = "2", *max_time = NULL;
-  const char* max_iter = "1500";
+  const char *out = "results", *nodes = GO_STR(GO_NODES_MAIN_JOB), *max_time = NULL;
+  const char *threads = GO_STR(GO_THREADS), *max_iter = GO_STR(GO_MAX_ITER_SWEEP);
   char speeds[256] = "0.8,2.0";
   int video = 1;
   const char* trial = GAITSIM_SOURCE_DIR "/mjmodels/trials/jw_ngait_og5";
@@ -138,7 +143,9 @@ int gs_cmd_run(int argc, char** argv) {
   // interrupted run leaves the steps that finished and no half-written folder
   char err[1024], sub_dir[4200];
   static const char* const kSteps[3][2] = {
-      {"track", "summary.json"}, {"track_n20", "summary.json"}, {"sweep", "sweep.csv"}};
+      {"track", "summary.json"},
+      {"track_n" GO_STR(GO_NODES_MAIN_JOB), "summary.json"},
+      {"sweep", "sweep.csv"}};
   for (int i = 0; i < 3; i++) {
     snprintf(sub_dir, sizeof(sub_dir), "%s/%s", out, kSteps[i][0]);
     if (gs_folder_replaceable(sub_dir, kSteps[i][1], err, sizeof(err)) != 0) {
@@ -148,16 +155,17 @@ int gs_cmd_run(int argc, char** argv) {
   }
   go_ipopt_install_stop_signals(gs_folder_abort_from_signal);
   char coarse[4096], track[4096];
-  snprintf(coarse, sizeof(coarse), "%s/track_n20", out);
+  snprintf(coarse, sizeof(coarse), "%s/track_n" GO_STR(GO_NODES_MAIN_JOB), out);
   snprintf(track, sizeof(track), "%s/track", out);
   int stopped_short = 0, rc;
 
-  // 1. tracking (20 nodes first when more are asked for)
-  int continued = strcmp(nodes, "20") != 0;
-  printf("[1] tracking solve of %s, %s nodes -> %s\n", trial, continued ? "20" : nodes,
+  // 1. tracking (GO_NODES_MAIN_JOB nodes first when more are asked for)
+  const char* main_nodes = GO_STR(GO_NODES_MAIN_JOB);
+  int continued = strcmp(nodes, main_nodes) != 0;
+  printf("[1] tracking solve of %s, %s nodes -> %s\n", trial, continued ? main_nodes : nodes,
          continued ? coarse : track);
-  const char* w1[] = {"track", trial, "--out", continued ? coarse : track, "--nodes", "20",
-                      "--threads", threads, "--max-iter", "600", NULL};
+  const char* w1[] = {"track", trial, "--out", continued ? coarse : track, "--nodes", main_nodes,
+                      "--threads", threads, "--max-iter", GO_STR(GO_MAX_ITER_MAIN_TRACK), NULL};
   rc = sub(gs_cmd_track, w1);
   if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
   stopped_short |= rc == GS_EXIT_STOPPED_SHORT;
@@ -165,7 +173,7 @@ int gs_cmd_run(int argc, char** argv) {
   if (continued) {
     printf("[1] tracking solve, %s nodes, started from it -> %s\n", nodes, track);
     const char* w2[] = {"track", trial, "--out", track, "--nodes", nodes, "--threads", threads,
-                        "--init", coarse, "--max-iter", "1000", NULL};
+                        "--init", coarse, "--max-iter", GO_STR(GO_MAX_ITER_MAIN_CONTINUED), NULL};
     rc = sub(gs_cmd_track, w2);
     if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
     stopped_short |= rc == GS_EXIT_STOPPED_SHORT;
@@ -179,7 +187,7 @@ int gs_cmd_run(int argc, char** argv) {
   printf("[2] predictive solves at %s m/s from the tracking solution -> %s\n",
          speeds, sweep_dir);
   const char* w3[] = {"sweep", "--guess", track, "--speeds", speeds, "--out", sweep_dir,
-                      "--nodes", continued ? nodes : "20", "--max-iter", max_iter,
+                      "--nodes", continued ? nodes : main_nodes, "--max-iter", max_iter,
                       max_time ? "--max-time" : NULL, max_time, NULL};
   rc = sub(gs_cmd_sweep, w3);
   if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;

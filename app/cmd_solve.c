@@ -2,15 +2,14 @@
 // the full-body muscle-driven model by direct collocation (optim/go_gait.h), either tracking the
 // measured coordinates and ground reactions of a trial or, at a prescribed speed, minimising the
 // cost of transport from a tracking solution. Both share one pipeline: problem, initial guess,
-// Ipopt, feasibility polish of a solve that stopped short, and the solution folder (OpenSim
-// storage files, variables.sto for restarts, summary.json).
+// the solve strategy (optim/go_solve.h: Ipopt, restarts, refinement, feasibility polish), and the
+// solution folder (OpenSim storage files, variables.sto for restarts, summary.json).
 #define _POSIX_C_SOURCE 200809L
 #include <getopt.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <time.h>
 
 #include <cjson/cJSON.h>
 #include <mujoco/mujoco.h>
@@ -27,9 +26,8 @@
 #include "io/gs_storage.h"
 #include "optim/go_gait.h"
 #include "optim/go_gait_guess.h"
-#include "optim/go_hessian.h"
 #include "optim/go_ipopt.h"
-#include "optim/go_jacobian.h"
+#include "optim/go_solve.h"
 
 static const char* kTrackUsage =
     "usage: gaitsim track TRIAL_DIR --out DIR [options]\n\n"
@@ -42,15 +40,16 @@ static const char* kTrackUsage =
     "polished, is written).\n\n"
     "  --model FILE        MJCF model (default: mjmodels/jw_fullbody_knee6.xml, the six-DOF\n"
     "                      implant knee; mjmodels/jw_fullbody.xml has the placeholder knee)\n"
-    "  --nodes N           collocation nodes (default 80)\n"
+    "  --nodes N           collocation nodes (default " GO_STR(GO_NODES_TRACK) ")\n"
     "  --init DIR          start from the solution in DIR: its variables.sto on the same nodes,\n"
     "                      or refined from fewer (N - 1 a multiple, e.g. 20 -> 39 -> 77, defects\n"
     "                      kept), else its states.sto and controls.sto interpolated (default:\n"
     "                      the trial)\n"
-    "  --threads N         worker threads (default 2)\n"
-    "  --max-iter N        Ipopt iteration limit (default 1000)\n"
+    "  --threads N         worker threads (default " GO_STR(GO_THREADS) ")\n"
+    "  --max-iter N        Ipopt iteration limit (default " GO_STR(GO_MAX_ITER) ")\n"
     "  --max-time S        wall-clock limit, s (default none)\n"
-    "  --activation A      initial activations and excitations (default 0.05)\n"
+    "  --activation A      initial activations and excitations (default " GO_STR(GO_ACTIVATION)
+    ")\n"
     "  --guess-method M    initial guess from the trial (without --init): trial (default:\n"
     "                      measured coordinates, activations A) or static (static optimisation\n"
     "                      at every node: min sum a^2 with the muscles' force-length-velocity\n"
@@ -61,8 +60,11 @@ static const char* kTrackUsage =
     "                      (partitioned quasi-Newton, SR1 per node element; experimental),\n"
     "                      gauss-newton (exact for the tracking squares, constraints left out)\n"
     "                      or exact (the Lagrangian's Hessian by structured finite differences)\n"
-    "  --weight NAME=W     goal weight, NAME one of pelvis_rot (default 10), pelvis_trans (10),\n"
-    "                      joint (1), grf (10), grm (0), effort (50), accel (0) (repeatable);\n"
+    "  --weight NAME=W     goal weight, NAME one of pelvis_rot (default "
+    GO_STR(GO_TRACK_W_PELVIS_ROT) "), pelvis_trans (" GO_STR(GO_TRACK_W_PELVIS_TRANS) "),\n"
+    "                      joint (" GO_STR(GO_TRACK_W_JOINT) "), grf (" GO_STR(GO_TRACK_W_GRF)
+    "), grm (" GO_STR(GO_TRACK_W_GRM) "), effort (" GO_STR(GO_TRACK_W_EFFORT) "), accel ("
+    GO_STR(GO_TRACK_W_ACCEL) ") (repeatable);\n"
     "                      grm: the ground reaction moment about the origin (centre of pressure\n"
     "                      x force, so the feet's placement); each tracking group is a mean of\n"
     "                      squared errors over 5 deg, 2 cm, 0.1 BW or 0.1 BW x 0.1 m;\n"
@@ -73,12 +75,15 @@ static const char* kTrackUsage =
     "                      followed by a Gauss-Newton projection of its best iterate onto the\n"
     "                      dynamics: the nearest dynamically consistent point)\n"
     "  --fallback-rise F   stop when the objective rises by more than the fraction F above the\n"
-    "                      lowest one reached at a violation <= 1e-4, and restart from the\n"
-    "                      best iterate (at most twice; summary.json restarts); default 0.25,\n"
+    "                      lowest one reached at a violation <= " GO_STR(GO_FALLBACK_VIOL)
+    ", and restart from the\n"
+    "                      best iterate (at most " GO_STR(GO_MAX_RESTARTS) " times; summary.json "
+    "restarts); default " GO_STR(GO_FALLBACK_RISE) ",\n"
     "                      0 turns the guard off\n"
     "  --refine N          after an L-BFGS solve that stopped short, up to N Newton\n"
     "                      iterations with the exact Hessian (structured finite differences)\n"
-    "                      from its best iterate (default 150, at most 600 s; 0: none;\n"
+    "                      from its best iterate (default " GO_STR(GO_REFINE_ITER) ", at most "
+    GO_STR(GO_REFINE_WALL_S) " s; 0: none;\n"
     "                      summary.json refine)\n"
     "  --ipopt KEY=VALUE   extra Ipopt option (repeatable)\n";
 
@@ -89,20 +94,14 @@ typedef struct {
   const char* init;    // solution folder to start from (NULL: the trial)
   int nodes;           // collocation nodes
   int threads;         // workers
-  int max_iter;        // iteration limit
-  double max_time;     // wall limit (s), <= 0: none
   double activation;   // initial activation (-)
   int guess_static;    // 1: static-optimisation guess (go_gait_guess_static), 0: the trial's
-  go_ipopt_opts ipopt; // solver options
+  go_solve_plan plan;  // the solve strategy's settings: Ipopt options, Hessian, iteration and
+                       // wall-clock limits, restarts, refinement, polish (optim/go_solve.h)
   double w_pelvis_rot, w_pelvis_trans, w_joint, w_grf, w_effort;  // goal weights (-)
   double w_grm;        // weight of the ground reaction moment (centre of pressure) goal (-)
   double w_accel;      // weight of the mean squared acceleration (qddot / 50)^2 (-)
   int fibre_bounds;    // predict: 1: 0.25 <= lM/lopt <= 1.5 path rows (go_gait_opts.fibre_bounds)
-  int pqn;             // 1: partitioned quasi-Newton Hessian (go_hessian.h)
-  int hess_fd;         // 1: exact Hessian by structured finite differences (go_hess_create_fd)
-  int refine_iter;     // track: Newton iterations with the exact Hessian after an L-BFGS solve
-                       // that stopped short (0: none)
-  int polish;          // 1: feasibility polish after a solve that stopped short
   int predict;         // 1: the predictive problem (gaitsim predict)
   const char* guess;   // predict: solution folder to start from (the tracking solution)
   double speed;        // predict: prescribed mean speed (m/s)
@@ -133,54 +132,28 @@ static int parse_weight(const char* arg, gsTrackOptions* o) {
   return -1;
 }
 
-// Newton iterations with the exact Hessian (go_hess_create_fd) that follow an L-BFGS tracking
-// solve which stopped short: from the main job's 600-iteration N = 20 solution they reached Ipopt's
-// acceptable level after 78 (238 s, 2 threads), J -3.8 % (docs/BENCHMARKS.md, "Exact-Hessian
-// refinement of the tracking solve")
-#define GS_REFINE_ITER 150
-#define GS_REFINE_WALL_S 600.0  // wall-clock cap of the refinement (s)
-#define GS_STOP_POLISH_S 30.0   // wall-clock cap of the polish after a stop signal (s)
-
-// the defaults of every option (tracking; gaitsim predict changes a few)
+// the defaults of every option (tracking; gaitsim predict changes a few): the solve strategy's
+// (stopping rule, fall-back guard, refinement, polish) from go_solve_plan_default, the values
+// from optim/go_defaults.h
 static void defaults(gsTrackOptions* o) {
-  char err[256];
   memset(o, 0, sizeof(*o));
   o->model = GS_DEFAULT_MODEL;
-  o->nodes = 80;
-  o->threads = 2;
-  o->max_iter = 1000;
-  o->activation = 0.05;
-  go_ipopt_opts_default(&o->ipopt);
-  o->ipopt.gauss_newton = 0;
-  o->pqn = 0;
-  o->polish = 1;
-  // stopping rule (overridable with --ipopt): Ipopt's own optimality at tol 1e-4, or its
-  // acceptable level: violation <= 1e-4 (scaled; the polish then projects the point onto the
-  // dynamics, to <= 1e-8) and the objective settled to 1e-4 relative per iteration over 15
-  // consecutive iterations. With 1e-6 instead of 1e-4, the predictions at 0.8 and 2.0 m/s went
-  // on past their settled objective (within 0.1 % of the lowest ever reached) and, in 2 of 4
-  // solves, climbed back 40-50 % when the adaptive barrier fell back to its monotone mode
-  // (docs/BENCHMARKS.md, "The acceptable level at 1e-4").
-  static const char* stop_rule[][2] = {
-      {"tol", "1e-4"},          {"constr_viol_tol", "1e-6"},
-      {"acceptable_tol", "1"},  {"acceptable_constr_viol_tol", "1e-4"},
-      {"acceptable_compl_inf_tol", "1e-3"}, {"acceptable_obj_change_tol", "1e-4"},
-      {"acceptable_iter", "15"}, {"limited_memory_max_history", "20"}};
-  for (size_t i = 0; i < sizeof(stop_rule) / sizeof(stop_rule[0]); i++)
-    go_ipopt_opts_set(&o->ipopt, stop_rule[i][0], stop_rule[i][1], err, sizeof(err));
-  o->w_pelvis_rot = o->w_pelvis_trans = o->w_grf = 10.0;
-  o->w_grm = 0.0;      // off: 10 narrows the stance to the measured one but, at 600 iterations,
-                       // worsens pelvis, GRF and knee tracking (docs/BENCHMARKS.md, 2026-12-02)
-  o->w_joint = 1.0;
-  o->w_effort = 50.0;  // 0.1 left mean activation at 0.37 (co-contraction); issue #6 note
-  o->w_accel = 0.0;    // tracking: none (results stay as they were); predict: PREDICT_W_ACCEL
+  o->nodes = GO_NODES_TRACK;
+  o->threads = GO_THREADS;
+  o->activation = GO_ACTIVATION;
+  go_solve_plan_default(&o->plan);
+  o->plan.max_iter = GO_MAX_ITER;
+  o->plan.progress = stderr;
+  o->w_pelvis_rot = GO_TRACK_W_PELVIS_ROT;
+  o->w_pelvis_trans = GO_TRACK_W_PELVIS_TRANS;
+  o->w_grf = GO_TRACK_W_GRF;
+  o->w_grm = GO_TRACK_W_GRM;
+  o->w_joint = GO_TRACK_W_JOINT;
+  o->w_effort = GO_TRACK_W_EFFORT;
+  o->w_accel = GO_TRACK_W_ACCEL;  // predict: GO_PREDICT_W_ACCEL
   o->fibre_bounds = 0; // tracking: none; predict: on (--no-fibre-bounds)
   o->metabolic_smoothing = 1.0;
-  o->refine_iter = GS_REFINE_ITER;  // tracking only; predict sets 0
-  // fall-back guard: stop when the objective rises 25 % above the lowest one reached at a
-  // violation <= 1e-4 (the acceptable level's), and restart from the best iterate (solve())
-  o->ipopt.fallback_rise = 0.25;
-  o->ipopt.fallback_viol = 1e-4;
+  o->plan.label = "track";  // the refinement: tracking only; predict turns it off
 }
 
 // the options of gaitsim track into o; 0, or GS_EXIT_USAGE after one line on stderr (the usage
@@ -199,6 +172,8 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
       {"refine", required_argument, NULL, 'r'},
       {"help", no_argument, NULL, 'h'},           {NULL, 0, NULL, 0}};
   static const char* const hessians[] = {"lbfgs", "pqn", "exact", "gauss-newton", NULL};
+  static const go_hessian_kind kinds[] = {GO_HESSIAN_LBFGS, GO_HESSIAN_PQN, GO_HESSIAN_EXACT,
+                                          GO_HESSIAN_GAUSS_NEWTON};
   static const char* const guesses[] = {"trial", "static", NULL};
   defaults(o);
   optind = 1;
@@ -211,26 +186,29 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
       case 'm': o->model = optarg; break;
       case 'n': bad = gs_opt_int("--nodes", optarg, GS_MIN_NODES, GS_MAX_NODES, &o->nodes); break;
       case 't': bad = gs_opt_int("--threads", optarg, 1, 64, &o->threads); break;
-      case 'i': bad = gs_opt_int("--max-iter", optarg, 0, GS_OPT_NO_MAX, &o->max_iter); break;
+      case 'i':
+        bad = gs_opt_int("--max-iter", optarg, 0, GS_OPT_NO_MAX, &o->plan.max_iter);
+        break;
       case 'T':
-        bad = gs_opt_real("--max-time", optarg, 0, HUGE_VAL, GS_OPT_LO_OPEN, &o->max_time);
+        bad = gs_opt_real("--max-time", optarg, 0, HUGE_VAL, GS_OPT_LO_OPEN, &o->plan.max_wall_s);
         break;
       case 'R':
-        bad = gs_opt_real("--fallback-rise", optarg, 0, HUGE_VAL, 0, &o->ipopt.fallback_rise);
+        bad = gs_opt_real("--fallback-rise", optarg, 0, HUGE_VAL, 0,
+                          &o->plan.ipopt.fallback_rise);
         break;
-      case 'r': bad = gs_opt_int("--refine", optarg, 0, GS_OPT_NO_MAX, &o->refine_iter); break;
+      case 'r':
+        bad = gs_opt_int("--refine", optarg, 0, GS_OPT_NO_MAX, &o->plan.refine_iter);
+        break;
       case 'a': bad = gs_opt_real("--activation", optarg, 0.001, 1, 0, &o->activation); break;
       case 'p':
-        if (go_ipopt_opts_add(&o->ipopt, optarg, err, sizeof(err)) != 0) {
+        if (go_ipopt_opts_add(&o->plan.ipopt, optarg, err, sizeof(err)) != 0) {
           fprintf(stderr, "gaitsim: --ipopt: %s\n", err);
           bad = 1;
         }
         break;
       case 'H':
         bad = gs_opt_choice("--hessian", optarg, hessians, &k);
-        o->pqn = !bad && k == 1;
-        o->hess_fd = !bad && k == 2;
-        o->ipopt.gauss_newton = !bad && k == 3;
+        if (!bad) o->plan.hessian = kinds[k];
         break;
       case 'w': bad = parse_weight(optarg, o); break;
       case 'I': o->init = optarg; break;
@@ -238,7 +216,7 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
         bad = gs_opt_choice("--guess-method", optarg, guesses, &k);
         o->guess_static = !bad && k == 1;
         break;
-      case 'P': o->polish = 0; break;
+      case 'P': o->plan.polish = 0; break;
       case 'h': fputs(kTrackUsage, stdout); return -1;
       default: return gs_opt_getopt_error("track", c, argv);
     }
@@ -416,7 +394,6 @@ static int guess_from_variables(const go_gait* g, const char* dir, double* z) {
 // (1-DOF) knee compressive joint reaction along the tibia (gs_knee_reaction.h), and the right
 // knee's ligament tension, the sum over its bundles (surrogate knee only)
 #define GS_KNEE_COLUMNS 5
-#define GS_MAX_RESTARTS 2  // restarts from the best iterate after fall-backs (solve())
 static const char* const kKneeLabels[GS_KNEE_COLUMNS] = {
     "contact_medial_r", "contact_lateral_r", "contact_total_r", "contact_total_l",
     "ligament_total_r"};
@@ -618,85 +595,6 @@ done:
   return status;
 }
 
-// constraint blocks of the gait NLP, for the diagnostic lines
-enum { BLOCKS = 9 };
-static const char* kBlockNames[BLOCKS] = {"defect", "link",  "eom", "hill", "act",
-                                          "grf",    "boundary", "fibre", "walk"};
-
-// block of constraint row r, its index within the node (state, path row, boundary row) and node
-static int block_of_row(go_gait* g, int r, int* idx, int* node) {
-  go_nlp* nlp = go_gait_nlp(g);
-  const go_gait_layout* L = go_gait_layout_get(g);
-  int p0 = go_nlp_row_path(nlp, 0, 0), b0 = go_nlp_row_boundary(nlp, 0);
-  if (r < p0) {
-    *idx = r % L->nx, *node = r / L->nx;
-    return 0;
-  }
-  if (r >= b0) {
-    *idx = r - b0, *node = 0;
-    return 6;
-  }
-  int pr = (r - p0) % L->n_path;
-  *idx = pr, *node = (r - p0) / L->n_path;
-  if (L->r_walk >= 0 && pr == L->r_walk) return 8;
-  if (L->r_fib >= 0 && pr >= L->r_fib) return 7;
-  return pr < L->r_eom ? 1 : pr < L->r_hill ? 2 : pr < L->r_act ? 3 : pr < L->r_grf ? 4 : 5;
-}
-
-// largest of v[r] per block, one line to stderr
-static void print_block_max(go_gait* g, const double* v, int mm, const char* what, int with_node) {
-  double mx[BLOCKS] = {0};
-  int at[BLOCKS] = {0}, node[BLOCKS] = {0};
-  for (int r = 0; r < mm; r++) {
-    int idx, k, blk = block_of_row(g, r, &idx, &k);
-    if (v[r] > mx[blk]) mx[blk] = v[r], at[blk] = idx, node[blk] = k;
-  }
-  fprintf(stderr, "%s by block:", what);
-  const go_gait_layout* L = go_gait_layout_get(g);
-  for (int b = 0; b < BLOCKS; b++) {
-    if ((b == 7 && L->r_fib < 0) || (b == 8 && L->r_walk < 0)) continue;  // rows not in the NLP
-    if (with_node) fprintf(stderr, " %s %.3g (#%d node %d)", kBlockNames[b], mx[b], at[b], node[b]);
-    else fprintf(stderr, " %s %.3g (#%d)", kBlockNames[b], mx[b], at[b]);
-  }
-  fprintf(stderr, "\n");
-}
-
-// largest |multiplier| per constraint block (solver scaling), one line to stderr: which
-// constraints the solve is fighting (a multiplier that grows without bound marks a degenerate or
-// nearly dependent block)
-static void print_largest_multipliers(go_gait* g, const double* lam, const char* what) {
-  int n, mm, ne;
-  go_nlp_sizes(go_gait_nlp(g), &n, &mm, &ne);
-  double* a = (double*)malloc(sizeof(double) * (size_t)mm);
-  if (!a) return;
-  for (int r = 0; r < mm; r++) a[r] = fabs(lam[r]);
-  char label[64];
-  snprintf(label, sizeof(label), "%s: largest multiplier", what);
-  print_block_max(g, a, mm, label, 1);
-  free(a);
-}
-
-// largest scaled violation per constraint block, one line to stderr: |g| for the equalities,
-// the distance outside [lb, ub] for the fibre rows
-static void print_blocks(go_gait* g, const double* gv, const char* when) {
-  go_nlp* nlp = go_gait_nlp(g);
-  int n, mm, ne;
-  go_nlp_sizes(nlp, &n, &mm, &ne);
-  double* gl = (double*)malloc(sizeof(double) * (size_t)mm);
-  double* gu = (double*)malloc(sizeof(double) * (size_t)mm);
-  double* xl = (double*)malloc(sizeof(double) * (size_t)n);
-  double* xu = (double*)malloc(sizeof(double) * (size_t)n);
-  double* v = (double*)malloc(sizeof(double) * (size_t)mm);
-  if (gl && gu && xl && xu && v) {
-    go_nlp_bounds(nlp, xl, xu, gl, gu);
-    for (int r = 0; r < mm; r++) v[r] = fmax(fmax(gl[r] - gv[r], gv[r] - gu[r]), 0.0);
-    char label[96];
-    snprintf(label, sizeof(label), "%s violation", when);
-    print_block_max(g, v, mm, label, 0);
-  }
-  free(gl), free(gu), free(xl), free(xu), free(v);
-}
-
 // measured knee contact force (N) of the trial at the N node times, N x 3: medial, lateral,
 // total (NAN where the file lacks the column); caller frees. NULL when the trial has no
 // knee_contact.sto with a contact_total_r column
@@ -751,35 +649,7 @@ done:
   return rc;
 }
 
-// Ipopt options for a solve that starts at a point near a solution (the restarts after a
-// fall-back, the exact-Hessian refinement): bound multipliers from a small barrier (z = mu / s,
-// mu 1e-6), so that the barrier update starts small, and the point barely pushed off its bounds
-static int set_start_near_solution(go_ipopt_opts* ro, char* err, int errsz) {
-  static const char* kv[][2] = {{"bound_mult_init_method", "mu-based"}, {"mu_init", "1e-6"},
-                                {"bound_push", "1e-8"}, {"bound_frac", "1e-8"}};
-  for (size_t i = 0; i < sizeof(kv) / sizeof(kv[0]); i++)
-    if (go_ipopt_opts_set(ro, kv[i][0], kv[i][1], err, errsz) != 0) return -1;
-  return 0;
-}
-
-// Ipopt's optimal or acceptable level: the project's stopping rule was met
-static int solve_converged(const go_solve_result* r) {
-  return r->status == GO_SOLVE_SUCCESS || r->status == GO_SOLVE_ACCEPTABLE;
-}
-
-// a solve that continued an earlier one: iterations, the best iterate's index, times add up
-static void continue_result(go_solve_result* later, const go_solve_result* earlier) {
-  later->iterations += earlier->iterations;
-  later->best_iter = later->best_iter >= 0 ? later->best_iter + earlier->iterations : -1;
-  later->wall_s += earlier->wall_s;
-  later->cpu_s += earlier->cpu_s;
-}
-
 static int solve(gsTrackOptions o);
-
-static double seconds_between(const struct timespec* a, const struct timespec* b) {
-  return (double)(b->tv_sec - a->tv_sec) + 1e-9 * (double)(b->tv_nsec - a->tv_nsec);
-}
 
 // the "trial" of DIR/summary.json (caller frees), or NULL when absent or unreadable
 static char* trial_of_solution(const char* dir) {
@@ -801,25 +671,6 @@ static char* trial_of_solution(const char* dir) {
 #define PREDICT_BAND_TRANS 0.05       // m
 #define PREDICT_BAND_ROT_SPEED 6.0    // rad/s
 #define PREDICT_BAND_TRANS_SPEED 1.0  // m/s
-// default acceleration goal weight of predict (-): at the tracking solution results/track (peak
-// |qddot| 500 rad/s^2, the variable bound) the goal is 0.26 against J = 178; after 40 iterations
-// at 0.8 m/s (polished) it cut RMS qddot from 62 to 45 and the peak from 353 to 183 rad/s^2 at
-// 0.06 % of J (1: 23 and 113, 0.13 %); small enough not to move the cost of transport
-#define PREDICT_W_ACCEL 0.1
-// default factor on the smooth Umberger 2010 widths of predict (-): with the widths of
-// gs_umberger_smoothing_default (steps 0.01 wide in u - a, lM~ - 1 and v~ in lopt/s) no full-body
-// prediction reached Ipopt's stopping test in up to 1500 L-BFGS iterations; 10 times wider, 0.8
-// m/s reached the acceptable level after 477 and 2.0 m/s the optimal solution after 993 from the
-// same tracking solution, and the exact (unsmoothed) cost of transport of the solution differs by
-// 1.8 % (docs/BENCHMARKS.md, 2026-12-02); 3 times wider did not converge in 1000 at 0.8 m/s
-#define PREDICT_METABOLIC_SMOOTHING 10.0
-// predict's floor on the summed vertical ground reaction of both feet at every node (BW): no
-// flight phase. Not in the paper; without it, 20-node solves at 2.0 m/s found a gait with 2 of
-// 20 nodes in flight (2.5 BW peaks) and a bouncing one with flight at 3 nodes and a 75 % longer
-// stride, cheaper than the walks; with it the same guess gave a walk (double support at 2 nodes,
-// lowest summed force 0.22 BW). Human walking keeps it above about 0.4 BW even at 2 m/s
-// (docs/BENCHMARKS.md, "Walking: a floor on the vertical ground reaction")
-#define PREDICT_MIN_VGRF 0.2
 static int predict_setup(const mjModel* m, gsTrackOptions* o, go_gait_opts* go, double** band,
                          double* T0, double* dx0) {
   gsTable states, controls;
@@ -990,20 +841,23 @@ static const char* kPredictUsage =
     "transport and peak triceps surae excitations. Exit status 3 when the solver stopped short.\n\n"
     "  --model FILE        MJCF model (default: the one TRACK_DIR/summary.json names, else\n"
     "                      mjmodels/jw_fullbody_knee6.xml)\n"
-    "  --nodes N           collocation nodes (default 20)\n"
-    "  --threads N         worker threads (default 2)\n"
-    "  --max-iter N        Ipopt iteration limit (default 1000)\n"
+    "  --nodes N           collocation nodes (default " GO_STR(GO_NODES_PREDICT) ")\n"
+    "  --threads N         worker threads (default " GO_STR(GO_THREADS) ")\n"
+    "  --max-iter N        Ipopt iteration limit (default " GO_STR(GO_MAX_ITER) ")\n"
     "  --max-time S        wall-clock limit, s (default none)\n"
     "  --weight NAME=W     regularisation weight: effort, the mean squared excitation (default\n"
-    "                      0.01); accel, the mean over all coordinates of (qddot / 50 rad/s^2\n"
-    "                      or m/s^2)^2 (default 0.1, a smoothness term; objective_share in\n"
+    "                      " GO_STR(GO_PREDICT_W_EFFORT)
+    "); accel, the mean over all coordinates of (qddot / 50 rad/s^2\n"
+    "                      or m/s^2)^2 (default " GO_STR(GO_PREDICT_W_ACCEL)
+    ", a smoothness term; objective_share in\n"
     "                      summary.json gives its fraction of J) (repeatable)\n"
     "  --no-fibre-bounds   no path bounds 0.25 <= lM/lopt <= 1.5 on every muscle's normalised\n"
     "                      fibre length (Lin, Walter & Pandy 2018, eq. 2; on by default; the\n"
     "                      guess's count outside them is printed)\n"
     "  --min-vgrf F        walking: the summed vertical ground reaction of both feet at least F\n"
     "                      body weights at every node, so no node is in flight (not in the\n"
-    "                      paper; default 0.2, 0 turns it off; summary.json min_summed_vgrf_bw,\n"
+    "                      paper; default " GO_STR(GO_PREDICT_MIN_VGRF)
+    ", 0 turns it off; summary.json min_summed_vgrf_bw,\n"
     "                      flight_nodes, double_support_nodes tell a walk from a run)\n"
     "  --stride-time S     hold the stride time at S seconds (0.4-2.5) instead of leaving it\n"
     "                      free: the cost of transport at a prescribed cadence\n"
@@ -1011,12 +865,15 @@ static const char* kPredictUsage =
     "                      guess's): where the solve starts, not a bound\n"
     "  --metabolic-smoothing F  factor on every width of the smooth Umberger 2010 rates\n"
     "                      (steps in u - a, lM~ - 1 and v~, the maxima and minima; widths of\n"
-    "                      gs_metabolics.h times F; default 10: steps 0.1 wide, which lets the\n"
+    "                      gs_metabolics.h times F; default " GO_STR(GO_PREDICT_METABOLIC_SMOOTHING)
+    ": steps 0.1 wide, which lets the\n"
     "                      solves converge; summary.json gives the exact cost of transport too)\n"
     "  --no-polish         no feasibility polish of a solve that stopped short\n"
     "  --fallback-rise F   stop when the objective rises by more than the fraction F above the\n"
-    "                      lowest one reached at a violation <= 1e-4, and restart from the\n"
-    "                      best iterate (at most twice; summary.json restarts); default 0.25,\n"
+    "                      lowest one reached at a violation <= " GO_STR(GO_FALLBACK_VIOL)
+    ", and restart from the\n"
+    "                      best iterate (at most " GO_STR(GO_MAX_RESTARTS) " times; summary.json "
+    "restarts); default " GO_STR(GO_FALLBACK_RISE) ",\n"
     "                      0 turns the guard off\n"
     "  --ipopt KEY=VALUE   extra Ipopt option (repeatable)\n";
 
@@ -1037,13 +894,14 @@ int gs_cmd_predict(int argc, char** argv) {
   gsTrackOptions o;
   defaults(&o);
   o.predict = 1;
-  o.refine_iter = 0;  // the exact Hessian leaves out the cost of transport's curvature
-  o.nodes = 20;
-  o.w_effort = 0.01;
-  o.w_accel = PREDICT_W_ACCEL;
-  o.metabolic_smoothing = PREDICT_METABOLIC_SMOOTHING;
+  o.plan.label = "predict";
+  o.plan.refine_iter = 0;  // the exact Hessian leaves out the cost of transport's curvature
+  o.nodes = GO_NODES_PREDICT;
+  o.w_effort = GO_PREDICT_W_EFFORT;
+  o.w_accel = GO_PREDICT_W_ACCEL;
+  o.metabolic_smoothing = GO_PREDICT_METABOLIC_SMOOTHING;
   o.fibre_bounds = 1;
-  o.min_vgrf = PREDICT_MIN_VGRF;
+  o.min_vgrf = GO_PREDICT_MIN_VGRF;
   optind = 1;
   opterr = 0;
   int c, bad = 0, model_given = 0;
@@ -1060,12 +918,12 @@ int gs_cmd_predict(int argc, char** argv) {
         break;
       case 'n': bad = gs_opt_int("--nodes", optarg, GS_MIN_NODES, GS_MAX_NODES, &o.nodes); break;
       case 't': bad = gs_opt_int("--threads", optarg, 1, 64, &o.threads); break;
-      case 'i': bad = gs_opt_int("--max-iter", optarg, 0, GS_OPT_NO_MAX, &o.max_iter); break;
+      case 'i': bad = gs_opt_int("--max-iter", optarg, 0, GS_OPT_NO_MAX, &o.plan.max_iter); break;
       case 'T':
-        bad = gs_opt_real("--max-time", optarg, 0, HUGE_VAL, GS_OPT_LO_OPEN, &o.max_time);
+        bad = gs_opt_real("--max-time", optarg, 0, HUGE_VAL, GS_OPT_LO_OPEN, &o.plan.max_wall_s);
         break;
       case 'w': bad = parse_weight(optarg, &o); break;
-      case 'P': o.polish = 0; break;
+      case 'P': o.plan.polish = 0; break;
       case 'F': o.fibre_bounds = 0; break;
       case 'D': bad = gs_opt_real("--stride-time", optarg, 0.4, 2.5, 0, &o.stride_time); break;
       case 'E':
@@ -1075,14 +933,14 @@ int gs_cmd_predict(int argc, char** argv) {
         bad = gs_opt_real("--min-vgrf", optarg, 0, 10, GS_OPT_HI_OPEN, &o.min_vgrf);
         break;
       case 'R':
-        bad = gs_opt_real("--fallback-rise", optarg, 0, HUGE_VAL, 0, &o.ipopt.fallback_rise);
+        bad = gs_opt_real("--fallback-rise", optarg, 0, HUGE_VAL, 0, &o.plan.ipopt.fallback_rise);
         break;
       case 'S':
         bad = gs_opt_real("--metabolic-smoothing", optarg, 0, 1e3, GS_OPT_LO_OPEN,
                           &o.metabolic_smoothing);
         break;
       case 'p':
-        if (go_ipopt_opts_add(&o.ipopt, optarg, err, sizeof(err)) != 0) {
+        if (go_ipopt_opts_add(&o.plan.ipopt, optarg, err, sizeof(err)) != 0) {
           fprintf(stderr, "gaitsim: --ipopt: %s\n", err);
           bad = 1;
         }
@@ -1112,14 +970,14 @@ int gs_cmd_track(int argc, char** argv) {
   return solve(o);
 }
 
-// the tracking (o.predict == 0) or predictive problem: build, guess, solve, polish, write
+// the tracking (o.predict == 0) or predictive problem: build, guess, solve (the plan,
+// go_solve_run), write
 static int solve(gsTrackOptions o) {
   char err[1024];
-  // the whole solve's clocks (summary.json wall_s, cpu_s): problem set-up, guess, every Ipopt
-  // solve (restarts, a refinement kept or not, the polish) and the output
-  struct timespec t_start, c_start;
-  clock_gettime(CLOCK_MONOTONIC, &t_start);
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c_start);
+  // the whole solve's clocks (summary.json wall_s, cpu_s): problem set-up, guess and every
+  // Ipopt solve (restarts, a refinement kept or not, the polish)
+  go_clock clock;
+  go_clock_start(&clock);
   // stop signals: the first stops the solve (its best iterate written, exit 3), a second ends
   // the process at once, the temporary output folder removed
   go_ipopt_install_stop_signals(gs_folder_abort_from_signal);
@@ -1148,10 +1006,9 @@ static int solve(gsTrackOptions o) {
   gs_table_init(&coords);
   gs_table_init(&grf);
   go_gait* g = NULL;
-  go_hess* hess = NULL;
-  double *z = NULL, *zb = NULL, *zs = NULL, *gv = NULL;
+  double* z = NULL;  // the start point
+  go_solve_report rep = {0};
   cJSON* summary = NULL;
-  cJSON* restarts = NULL;  // summary.json "restarts", one object per restart after a fall-back
   char path[4096];
   const char* what = o.predict ? "predict" : "track";
   double grf_scale = 0, *band = NULL, T0 = 0, dx0 = 0;
@@ -1200,13 +1057,13 @@ static int solve(gsTrackOptions o) {
     fprintf(stderr, "gaitsim: %s: %s\n", what, err);
     goto done;
   }
-  go_nlp* nlp = go_gait_nlp(g);
   int n, mm, ne;
-  go_nlp_sizes(nlp, &n, &mm, &ne);
+  go_nlp_sizes(go_gait_nlp(g), &n, &mm, &ne);
   z = (double*)malloc(sizeof(double) * (size_t)n);
-  zb = (double*)malloc(sizeof(double) * (size_t)n);
-  zs = (double*)malloc(sizeof(double) * (size_t)n);
-  gv = (double*)malloc(sizeof(double) * (size_t)mm);
+  if (!z) {
+    fprintf(stderr, "gaitsim: %s: out of memory\n", what);
+    goto done;
+  }
   if (o.predict) {
     memcpy(z, band, sizeof(double) * (size_t)n);
     retime_progression(g, z, o.speed,
@@ -1230,190 +1087,15 @@ static int solve(gsTrackOptions o) {
     fprintf(stderr, "gaitsim: track: %s\n", err);
     goto done;
   }
-  go_nlp_scale_z(nlp, z, zs);
-  double viol0 = go_nlp_eval_g(nlp, zs, gv) == 0 ? go_nlp_violation(nlp, gv) : INFINITY;
-  fprintf(stderr, "%s: %d nodes, %d variables, %d constraints, %d Jacobian nonzeros, %d "
-          "colour groups, %d threads; initial violation %.3g\n", what, o.nodes, n, mm, ne,
-          go_nlp_path_groups(nlp), o.threads, viol0);
-  print_blocks(g, gv, o.predict ? "predict: initial" : "track: initial");
-  o.ipopt.max_iter = o.max_iter;
-  o.ipopt.max_wall_s = o.max_time;
-  o.ipopt.progress = stderr;
-  o.ipopt.handle_sigint = 1;
-  if ((o.pqn && go_hess_create(&hess, nlp, go_gait_elements(g), err, sizeof(err)) != 0) ||
-      (o.hess_fd && go_hess_create_fd(&hess, nlp, go_gait_elements(g), err, sizeof(err)) != 0)) {
-    fprintf(stderr, "gaitsim: track: %s\n", err);
+  // the solve strategy (optim/go_solve.h)
+  o.plan.gait = g;
+  o.plan.z0 = z;
+  o.plan.clock = &clock;
+  if (go_solve_run(&o.plan, &rep, err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s: %s\n", what, err);
     goto done;
   }
-  o.ipopt.hess = hess;
-  go_solve_result res;
-  // the final constraint multipliers, for the diagnostic line (the largest per block)
-  double* lam = (double*)calloc((size_t)mm, sizeof(double));
-  go_ipopt_mult mult = {lam, NULL, NULL, 0};
-  if (go_ipopt_solve(nlp, &o.ipopt, z, zb, lam ? &mult : NULL, &res, err, sizeof(err)) != 0) {
-    fprintf(stderr, "gaitsim: track: %s\n", err);
-    free(lam);
-    goto done;
-  }
-  // restarts after a fall-back: Ipopt once came near a solution (violation <= 1e-4) and left it
-  // (the adaptive barrier's fixed mode or a restoration phase raised mu by 3-9 decades and the
-  // objective by 40-600 %; docs/BENCHMARKS.md, "Fall-backs and restarts"). Start again from the
-  // best iterate with the iterations left (set_start_near_solution); at most GS_MAX_RESTARTS
-  // times
-  restarts = cJSON_CreateArray();
-  int n_restarts = 0;
-  while (res.status == GO_SOLVE_FELL_BACK && res.best_iter >= 0 && n_restarts < GS_MAX_RESTARTS &&
-         (o.max_iter < 0 || res.iterations < o.max_iter) &&
-         (o.max_time <= 0 || res.wall_s < o.max_time)) {
-    cJSON* rj = cJSON_CreateObject();
-    cJSON_AddNumberToObject(rj, "after_iterations", res.iterations);
-    cJSON_AddNumberToObject(rj, "from_iteration", res.best_iter);
-    cJSON_AddNumberToObject(rj, "objective", res.best_objective);
-    cJSON_AddNumberToObject(rj, "violation", res.best_viol);
-    cJSON_AddItemToArray(restarts, rj);
-    fprintf(stderr, "%s: fell back after %d iterations; restart from the best iterate (iteration "
-            "%d, objective %.6g, violation %.3g)\n", what, res.iterations, res.best_iter,
-            res.best_objective, res.best_viol);
-    go_ipopt_opts ro = o.ipopt;
-    if (o.max_iter >= 0) ro.max_iter = o.max_iter - res.iterations;
-    if (o.max_time > 0) ro.max_wall_s = o.max_time - res.wall_s;
-    if (set_start_near_solution(&ro, err, sizeof(err)) != 0) {
-      fprintf(stderr, "gaitsim: track: restart: %s\n", err);
-      free(lam);
-      goto done;
-    }
-    memcpy(z, zb, sizeof(double) * (size_t)n);
-    go_solve_result r2;
-    if (go_ipopt_solve(nlp, &ro, z, zb, lam ? &mult : NULL, &r2, err, sizeof(err)) != 0) {
-      fprintf(stderr, "gaitsim: track: restart: %s\n", err);
-      free(lam);
-      goto done;
-    }
-    // the restart's iteration 0 is the best iterate itself (pushed 1e-8 off its bounds), so its
-    // best iterate is at least as good; counts and times add up
-    continue_result(&r2, &res);
-    res = r2;
-    n_restarts++;
-  }
-  // exact-Hessian refinement of an L-BFGS tracking solve that stopped short: Newton from the best
-  // iterate with a small barrier (mu 1e-6, bound multipliers mu / s, the point barely pushed off
-  // its bounds); its result replaces the L-BFGS one when Ipopt reaches its optimal or acceptable
-  // level, and so does its best iterate when that beats the L-BFGS best iterate (the glue's
-  // ranking); otherwise the L-BFGS best iterate stays
-  go_solve_result rres;
-  int refined = -1;  // -1 not run, 0 run and not used, 1 used
-  if (o.refine_iter > 0 && !o.hess_fd && !o.pqn && !o.ipopt.gauss_newton && res.best_iter >= 0 &&
-      !solve_converged(&res) &&
-      res.status != GO_SOLVE_INTERRUPTED && (o.max_time <= 0 || res.wall_s < o.max_time)) {
-    if (go_hess_create_fd(&hess, nlp, go_gait_elements(g), err, sizeof(err)) != 0) {
-      fprintf(stderr, "gaitsim: track: refine: %s\n", err);
-      free(lam);
-      goto done;
-    }
-    go_ipopt_opts ro = o.ipopt;
-    ro.hess = hess;
-    ro.max_iter = o.refine_iter;
-    // at most GS_REFINE_WALL_S, or what is left of --max-time (at N = 80 one exact-Hessian
-    // iteration costs about 4 times the N = 20 one)
-    ro.max_wall_s = o.max_time > 0 ? fmin(o.max_time - res.wall_s, GS_REFINE_WALL_S)
-                                   : GS_REFINE_WALL_S;
-    if (set_start_near_solution(&ro, err, sizeof(err)) != 0) {
-      fprintf(stderr, "gaitsim: track: refine: %s\n", err);
-      free(lam);
-      goto done;
-    }
-    fprintf(stderr, "%s: %s after %d iterations; exact-Hessian refinement from the best iterate "
-            "(iteration %d, objective %.6g, violation %.3g), up to %d iterations\n", what,
-            go_solve_status_str(res.status), res.iterations, res.best_iter, res.best_objective,
-            res.best_viol, o.refine_iter);
-    // z (Ipopt's point of a solve that stopped short, not used: its output is zb) takes the
-    // refinement's point, zs (scratch until the polish) its best iterate
-    memcpy(z, zb, sizeof(double) * (size_t)n);
-    if (go_ipopt_solve(nlp, &ro, z, zs, lam ? &mult : NULL, &rres, err, sizeof(err)) != 0) {
-      fprintf(stderr, "gaitsim: track: refine: %s\n", err);
-      free(lam);
-      goto done;
-    }
-    // used: converged, or stopped short at a best iterate that beats the L-BFGS one by the
-    // glue's ranking (among points the polish can take, the lower objective)
-    refined = solve_converged(&rres) ||
-              (rres.best_iter >= 0 &&
-               go_ipopt_point_better(rres.best_objective, rres.best_viol, res.best_objective,
-                                     res.best_viol, ro.best_viol_tol));
-    fprintf(stderr, "%s: refinement: %s after %d iterations, %.1f s, objective %.6g%s\n", what,
-            go_solve_status_str(rres.status), rres.iterations, rres.wall_s, rres.objective,
-            solve_converged(&rres) ? ""
-            : refined ? "; its best iterate beats the L-BFGS one and is kept"
-                      : "; the L-BFGS best iterate stays");
-    if (refined) {
-      memcpy(zb, zs, sizeof(double) * (size_t)n);
-      go_solve_result merged = rres;
-      continue_result(&merged, &res);
-      res = merged;
-    }
-  }
-  if (lam) print_largest_multipliers(g, lam, o.predict ? "predict" : "track");
-  free(lam);
-  int converged = solve_converged(&res);
-  double* zout = converged || res.best_iter < 0 ? z : zb;
-  // feasibility polish: the dynamically consistent point nearest to the returned point (Ipopt's
-  // when it converged, whose acceptable test allows a violation of 1e-4, else the best iterate;
-  // go_gait_set_proximal), by Gauss-Newton, whenever that point is violated by more than 1e-8
-  go_solve_result pres;
-  int polished = 0;
-  double viol_before = converged ? res.max_viol : res.best_viol;
-  int want_polish = o.polish && (converged || res.best_iter >= 0) && viol_before > 1e-8;
-  if (want_polish) {
-    if (go_gait_set_proximal(g, zout) != 0) {
-      fprintf(stderr, "gaitsim: track: out of memory (polish)\n");
-      goto done;
-    }
-    if (z != zout) memcpy(z, zout, sizeof(double) * (size_t)n);
-    go_ipopt_opts po;
-    go_ipopt_opts_default(&po);
-    po.gauss_newton = 1;
-    po.max_iter = 200;
-    po.max_wall_s = o.max_time;
-    // after a stop signal, only a quick polish (a second signal ends it at once, writing nothing)
-    if (res.status == GO_SOLVE_INTERRUPTED &&
-        !(po.max_wall_s > 0 && po.max_wall_s < GS_STOP_POLISH_S))
-      po.max_wall_s = GS_STOP_POLISH_S;
-    po.progress = stderr;
-    po.handle_sigint = 1;
-    go_ipopt_opts_set(&po, "tol", "1e-6", err, sizeof(err));
-    go_ipopt_opts_set(&po, "constr_viol_tol", "1e-8", err, sizeof(err));
-    // start at the best iterate itself: a small barrier, the point barely pushed off its bounds.
-    // The barrier's pull mu / s on a variable pushed 1e-8 off its bound must stay below the
-    // proximal term's: with mu 1e-6 (100 there) the polish of a prediction at 2.0 m/s, whose
-    // activations sit at their 0.001 bound, wandered for 200 iterations at 2e-5 - 1e-3; with
-    // 1e-9 it reached 1.6e-9 in 7 (docs/BENCHMARKS.md, "The acceptable level at 1e-4")
-    go_ipopt_opts_set(&po, "mu_init", "1e-9", err, sizeof(err));
-    go_ipopt_opts_set(&po, "bound_push", "1e-8", err, sizeof(err));
-    go_ipopt_opts_set(&po, "bound_frac", "1e-8", err, sizeof(err));
-    fprintf(stderr, "%s: feasibility polish from violation %.3g\n", what, viol_before);
-    int prc = go_ipopt_solve(nlp, &po, z, zs, NULL, &pres, err, sizeof(err));
-    go_gait_set_proximal(g, NULL);
-    if (prc != 0) {
-      fprintf(stderr, "gaitsim: track: polish: %s\n", err);
-      goto done;
-    }
-    int pconv = solve_converged(&pres);
-    const double* zp = pconv || pres.best_iter < 0 ? z : zs;
-    double vp = pconv || pres.best_iter < 0 ? pres.max_viol : pres.best_viol;
-    if (vp < viol_before) {
-      memcpy(zb, zp, sizeof(double) * (size_t)n);
-      zout = zb;
-      polished = 1;
-    }
-  }
-  go_nlp_scale_z(nlp, zout, zs);
-  double fout;
-  double obj_out = go_nlp_eval_f(nlp, zs, &fout) == 0 ? go_nlp_objective_phys(nlp, fout) : NAN;
-  double viol = go_nlp_eval_g(nlp, zs, gv) == 0 ? go_nlp_violation(nlp, gv) : INFINITY;
-  print_blocks(g, gv, o.predict ? "predict: final" : "track: final");
-  double max_defect = 0;
-  const go_gait_layout* L = go_gait_layout_get(g);
-  for (int r = 0; r < (o.nodes - 1) * L->nx; r++) max_defect = fmax(max_defect, fabs(gv[r]));
+  const go_solve_result* res = &rep.result;
   summary = cJSON_CreateObject();
   cJSON_AddStringToObject(summary, "problem", o.predict ? "prediction" : "tracking");
   cJSON_AddStringToObject(summary, "model", o.model);
@@ -1426,43 +1108,48 @@ static int solve(gsTrackOptions o) {
   } else {
     cJSON_AddStringToObject(summary, "trial", o.trial);
   }
-  cJSON_AddStringToObject(summary, "status", go_solve_status_str(res.status));
-  cJSON_AddNumberToObject(summary, "iterations", res.iterations);
-  cJSON_AddItemToObject(summary, "restarts", restarts);  // after fall-backs, in order
-  restarts = NULL;
-  if (refined >= 0) {
+  cJSON_AddStringToObject(summary, "status", go_solve_status_str(res->status));
+  cJSON_AddNumberToObject(summary, "iterations", res->iterations);
+  cJSON* restarts = cJSON_AddArrayToObject(summary, "restarts");  // after fall-backs, in order
+  for (int r = 0; r < rep.n_restarts; r++) {
+    cJSON* rj = cJSON_CreateObject();
+    cJSON_AddNumberToObject(rj, "after_iterations", rep.restarts[r].after_iterations);
+    cJSON_AddNumberToObject(rj, "from_iteration", rep.restarts[r].from_iteration);
+    cJSON_AddNumberToObject(rj, "objective", rep.restarts[r].objective);
+    cJSON_AddNumberToObject(rj, "violation", rep.restarts[r].violation);
+    cJSON_AddItemToArray(restarts, rj);
+  }
+  if (rep.refined >= 0) {
     cJSON* fj = cJSON_AddObjectToObject(summary, "refine");
     cJSON_AddStringToObject(fj, "hessian", "exact (structured finite differences)");
-    cJSON_AddStringToObject(fj, "status", go_solve_status_str(rres.status));
-    cJSON_AddNumberToObject(fj, "iterations", rres.iterations);
-    cJSON_AddNumberToObject(fj, "wall_s", rres.wall_s);
-    cJSON_AddNumberToObject(fj, "objective", rres.objective);
-    cJSON_AddBoolToObject(fj, "used", refined);
+    cJSON_AddStringToObject(fj, "status", go_solve_status_str(rep.refine.status));
+    cJSON_AddNumberToObject(fj, "iterations", rep.refine.iterations);
+    cJSON_AddNumberToObject(fj, "wall_s", rep.refine.wall_s);
+    cJSON_AddNumberToObject(fj, "objective", rep.refine.objective);
+    cJSON_AddBoolToObject(fj, "used", rep.refined);
   }
   // Ipopt's own measures at its last iteration (scaled problem; before the polish)
   cJSON* lj = cJSON_AddObjectToObject(summary, "ipopt_last_iteration");
-  cJSON_AddNumberToObject(lj, "inf_pr", res.last_inf_pr);
-  cJSON_AddNumberToObject(lj, "inf_du", res.last_inf_du);
-  cJSON_AddNumberToObject(lj, "mu", res.last_mu);
-  cJSON_AddBoolToObject(lj, "restoration", res.last_restoration);
-  struct timespec t_now, c_now;
-  clock_gettime(CLOCK_MONOTONIC, &t_now);
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &c_now);
-  cJSON_AddNumberToObject(summary, "wall_s", seconds_between(&t_start, &t_now));
-  cJSON_AddNumberToObject(summary, "cpu_s", seconds_between(&c_start, &c_now));
-  cJSON_AddNumberToObject(summary, "ipopt_wall_s", res.wall_s);  // the solves behind the result
+  cJSON_AddNumberToObject(lj, "inf_pr", res->last_inf_pr);
+  cJSON_AddNumberToObject(lj, "inf_du", res->last_inf_du);
+  cJSON_AddNumberToObject(lj, "mu", res->last_mu);
+  cJSON_AddBoolToObject(lj, "restoration", res->last_restoration);
+  cJSON_AddNumberToObject(summary, "wall_s", rep.wall_s);  // from the start of solve()
+  cJSON_AddNumberToObject(summary, "cpu_s", rep.cpu_s);
+  cJSON_AddNumberToObject(summary, "ipopt_wall_s", res->wall_s);  // the solves behind the result
   cJSON_AddNumberToObject(summary, "nodes", o.nodes);
   cJSON_AddNumberToObject(summary, "threads", o.threads);
-  cJSON_AddNumberToObject(summary, "stride_time_s", go_gait_time_of(g, zout));
+  cJSON_AddNumberToObject(summary, "stride_time_s", go_gait_time_of(g, rep.z));
   cJSON_AddNumberToObject(summary, "body_weight_n", go_gait_weight(g));
   if (o.predict) {
-    predict_summary(g, zout, &o, T0, dx0, obj_out, summary);
+    predict_summary(g, rep.z, &o, T0, dx0, rep.objective, summary);
   } else {
     cJSON_AddNumberToObject(summary, "grf_scale", grf_scale);
   }
+  double obj_out = rep.objective;
   cJSON_AddNumberToObject(summary, "objective", obj_out);
   double terms[GO_GAIT_NTERMS];  // each goal's part of J and its share
-  if (go_gait_objective_terms(g, zout, terms) == 0) {
+  if (go_gait_objective_terms(g, rep.z, terms) == 0) {
     static const char* tn[GO_GAIT_NTERMS] = GO_GAIT_TERM_NAMES;
     cJSON* tj = cJSON_AddObjectToObject(summary, "objective_terms");
     cJSON* sj = cJSON_AddObjectToObject(summary, "objective_share");
@@ -1471,22 +1158,22 @@ static int solve(gsTrackOptions o) {
       cJSON_AddNumberToObject(sj, tn[t], obj_out > 0 ? terms[t] / obj_out : 0.0);
     }
   }
-  if (want_polish) {
+  if (rep.polish_run) {
     cJSON* pj = cJSON_AddObjectToObject(summary, "polish");
-    cJSON_AddStringToObject(pj, "status", go_solve_status_str(pres.status));
-    cJSON_AddNumberToObject(pj, "iterations", pres.iterations);
-    cJSON_AddNumberToObject(pj, "wall_s", pres.wall_s);
-    cJSON_AddNumberToObject(pj, "violation_before", viol_before);
+    cJSON_AddStringToObject(pj, "status", go_solve_status_str(rep.polish.status));
+    cJSON_AddNumberToObject(pj, "iterations", rep.polish.iterations);
+    cJSON_AddNumberToObject(pj, "wall_s", rep.polish.wall_s);
+    cJSON_AddNumberToObject(pj, "violation_before", rep.polish_viol_before);
     // the objective J of the point polished (what the polish costs: J there against "objective")
-    cJSON_AddNumberToObject(pj, "objective_before", converged ? res.objective : res.best_objective);
-    cJSON_AddBoolToObject(pj, "used", polished);
+    cJSON_AddNumberToObject(pj, "objective_before", rep.polish_obj_before);
+    cJSON_AddBoolToObject(pj, "used", rep.polished);
   }
-  cJSON_AddNumberToObject(summary, "initial_violation", viol0);
-  cJSON_AddNumberToObject(summary, "max_violation", viol);
-  cJSON_AddNumberToObject(summary, "max_defect", max_defect);
-  cJSON_AddBoolToObject(summary, "best_iterate_written", zout == zb);
+  cJSON_AddNumberToObject(summary, "initial_violation", rep.initial_violation);
+  cJSON_AddNumberToObject(summary, "max_violation", rep.max_violation);
+  cJSON_AddNumberToObject(summary, "max_defect", rep.max_defect);
+  cJSON_AddBoolToObject(summary, "best_iterate_written", rep.best_iterate_written);
   double* knee_ref = o.predict ? NULL : measured_knee_contact(o.trial, g);
-  int wrote_solution = write_solution(g, zout, tx.staging, knee_ref, summary);
+  int wrote_solution = write_solution(g, rep.z, tx.staging, knee_ref, summary);
   free(knee_ref);
   if (wrote_solution != 0) goto done;
   char* text = cJSON_Print(summary);
@@ -1503,15 +1190,15 @@ static int solve(gsTrackOptions o) {
     goto done;
   }
   printf("%s: %s after %d iterations, %.1f s; max violation %.3g (from %.3g); wrote %s\n", what,
-         go_solve_status_str(res.status), res.iterations, res.wall_s, viol, viol0, o.out);
-  status = converged ? GS_EXIT_OK : GS_EXIT_STOPPED_SHORT;
+         go_solve_status_str(res->status), res->iterations, res->wall_s, rep.max_violation,
+         rep.initial_violation, o.out);
+  status = rep.converged ? GS_EXIT_OK : GS_EXIT_STOPPED_SHORT;
 
 done:
   gs_folder_abort(&tx);  // nothing when committed
   cJSON_Delete(summary);
-  cJSON_Delete(restarts);
-  free(z), free(zb), free(zs), free(gv), free(band);
-  go_hess_free(hess);
+  go_solve_report_free(&rep);
+  free(z), free(band);
   go_gait_free(g);
   gs_table_free(&coords);
   gs_table_free(&grf);

@@ -22,6 +22,7 @@
 #include "app/gs_options.h"
 #include "io/gs_atomic.h"
 #include "io/gs_storage.h"
+#include "optim/go_defaults.h"
 #include "optim/go_ipopt.h"
 
 #define SWEEP_MAX_SPEEDS GS_MAX_SPEEDS
@@ -37,10 +38,11 @@ static const char* kSweepUsage =
     "SIGTERM, SIGHUP) reaches both processes: the running solves write their best iterates and\n"
     "DIR holds the speeds solved, the table saying which were not (exit 3); a second signal\n"
     "ends the sweep at once and DIR stays as it was. No speed solved: DIR stays as it was.\n\n"
-    "  --nodes N       collocation nodes (default 20)\n"
+    "  --nodes N       collocation nodes (default " GO_STR(GO_NODES_PREDICT) ")\n"
     "  --max-time S    wall-clock limit of each solve, s (default none: the iteration limit,\n"
     "                  so that the results do not depend on the load of the machine)\n"
-    "  --max-iter N    Ipopt iteration limit of each solve (default 1500)\n";
+    "  --max-iter N    Ipopt iteration limit of each solve (default " GO_STR(GO_MAX_ITER_SWEEP)
+    ")\n";
 
 // the guess's mean speed (summary.json speed_mps), or NAN
 static double guess_speed(const char* dir) {
@@ -137,7 +139,8 @@ int gs_cmd_sweep(int argc, char** argv) {
       {"max-time", required_argument, NULL, 'T'}, {"max-iter", required_argument, NULL, 'i'},
       {"help", no_argument, NULL, 'h'},
       {NULL, 0, NULL, 0}};
-  const char *guess = NULL, *dir = NULL, *nodes = "20", *max_time = NULL, *max_iter = "1500";
+  const char *guess = NULL, *dir = NULL, *nodes = GO_STR(GO_NODES_PREDICT), *max_time = NULL;
+  const char* max_iter = GO_STR(GO_MAX_ITER_SWEEP);
   double v[SWEEP_MAX_SPEEDS];
   int n = -1, c, bad = 0;
   optind = 1;

@@ -11,6 +11,7 @@
 #include "callbacks/gs_model_info.h"
 #include "callbacks/gs_muscle.h"
 #include "callbacks/gs_physics.h"
+#include "optim/go_defaults.h"
 #include "optim/go_jacobian.h"
 
 // variable scales (physical units per solver unit)
@@ -96,7 +97,7 @@ struct go_gait {
 
 void go_gait_opts_default(go_gait_opts* o) {
   memset(o, 0, sizeof(*o));
-  o->N = 40;
+  o->N = GO_NODES_TRACK;
   o->nthreads = 1;
   o->w_pelvis_rot = 1.0;
   o->w_pelvis_trans = 1.0;
@@ -114,6 +115,7 @@ go_nlp* go_gait_nlp(go_gait* g) { return g->nlp; }
 const go_gait_layout* go_gait_layout_get(const go_gait* g) { return &g->L; }
 const mjModel* go_gait_model(const go_gait* g) { return g->m; }
 int go_gait_nodes(const go_gait* g) { return g->N; }
+int go_gait_threads(const go_gait* g) { return g->nthreads; }
 double go_gait_stride_time(const go_gait* g) { return g->T; }
 double go_gait_weight(const go_gait* g) { return g->weight; }
 double go_gait_q_ref(const go_gait* g, int k, int j) { return g->q_ref[k * g->L.nv + j]; }
@@ -525,11 +527,13 @@ static double lcg(unsigned long long* s) {
   return ((double)(*s >> 11) / 9007199254740992.0) * 2.0 - 1.0;
 }
 
-// crossing matrix over the trial poses and random poses around them
-static void crossing(go_gait* g, const gsTable* coords, const int* qcol) {
+// crossing matrix over the trial poses and random poses around them; 0, or -1 when out of
+// memory
+static int crossing(go_gait* g, const gsTable* coords, const int* qcol) {
   const mjModel* m = g->m;
   int nv = m->nv, na = g->L.na;
   mjData* d = mj_makeData(m);
+  if (!d) return -1;
   int nrow = coords ? coords->nrow : 1;
   unsigned long long seed = 12345;
   for (int pose = 0; pose < nrow + CROSS_RANDOM_POSES; pose++) {
@@ -556,6 +560,7 @@ static void crossing(go_gait* g, const gsTable* coords, const int* qcol) {
     }
   }
   mj_deleteData(d);
+  return 0;
 }
 
 // the path pattern (compressed columns); returns the number of entries, writes them when the
@@ -848,6 +853,10 @@ static int references(go_gait* g, const go_gait_opts* o, const int* qcol, char* 
   for (int q = 0; q < N * nv; q++) g->q_ref[q] = NAN;
   for (int q = 0; q < N * GO_GAIT_NGRF; q++) g->grf_ref[q] = NAN;
   double* times = (double*)zalloc((size_t)N, sizeof(double));
+  if (!times) {
+    snprintf(err, (size_t)errsz, "go_gait_create: out of memory (references)");
+    return -1;
+  }
   gsTable rs;
   gs_table_init(&rs);
   int status = 0;
@@ -900,58 +909,86 @@ static int references(go_gait* g, const go_gait_opts* o, const int* qcol, char* 
   return status;
 }
 
-int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char* err,
-                   int errsz) {
-  *out = NULL;
+// go_gait_create's phases. Each fills its part of g from the options and returns 0, or -1 with
+// the reason in err; what it allocated stays in g, which go_gait_free releases.
+
+// "out of memory" for phase what; -1
+static int out_of_memory(char* err, int errsz, const char* what) {
+  snprintf(err, (size_t)errsz, "go_gait_create: out of memory (%s)", what);
+  return -1;
+}
+
+// the options and the model a problem can be built from
+static int check_inputs(const mjModel* m0, const go_gait_opts* o, char* err, int errsz) {
   if (o->N < 2 || o->nthreads < 1) {
-    snprintf(err, errsz, "go_gait_create: need N >= 2 and nthreads >= 1");
+    snprintf(err, (size_t)errsz, "go_gait_create: need N >= 2 and nthreads >= 1");
     return -1;
   }
   if (m0->nq != m0->nv || m0->na != m0->nu || m0->nu == 0) {
-    snprintf(err, errsz, "go_gait_create: need nq == nv (no free or ball joints) and an "
+    snprintf(err, (size_t)errsz, "go_gait_create: need nq == nv (no free or ball joints) and an "
              "activation state for every actuator (nq %d nv %d nu %d na %d)", m0->nq, m0->nv,
              m0->nu, m0->na);
     return -1;
   }
   if (m0->nuserdata < GS_USERDATA_SIZE(m0)) {
-    snprintf(err, errsz, "go_gait_create: model not prepared (gs_physics_prepare)");
+    snprintf(err, (size_t)errsz, "go_gait_create: model not prepared (gs_physics_prepare)");
     return -1;
   }
   if (o->coords && o->coords->nrow < 2) {
-    snprintf(err, errsz, "go_gait_create: coordinate table needs 2 rows or more");
+    snprintf(err, (size_t)errsz, "go_gait_create: coordinate table needs 2 rows or more");
     return -1;
   }
-  go_gait* g = (go_gait*)calloc(1, sizeof(go_gait));
-  if (!g) {
-    snprintf(err, errsz, "go_gait_create: out of memory");
-    return -1;
-  }
-  g->m = mj_copyModel(NULL, m0);
-  g->m->opt.disableflags |= mjDSBL_CONSTRAINT;
-  const mjModel* m = g->m;
-  int nv = m->nv, na = m->na;
-  g->N = o->N;
-  g->T = o->T > 0 ? o->T
-                  : (o->coords ? o->coords->time[o->coords->nrow - 1] - o->coords->time[0] : 1.0);
-  g->weight = mj_getTotalmass(m) * mju_norm3(m->opt.gravity);
-  g->speed = o->speed > 0 ? o->speed : 0;
-  g->nthreads = o->nthreads;
-  g->free_time = o->free_time;
-  if (na > GO_GAIT_MAX_MUSCLES || (o->w_cot > 0 && !(g->speed > 0)) ||
+  if (m0->na > GO_GAIT_MAX_MUSCLES || (o->w_cot > 0 && !(o->speed > 0)) ||
       (o->free_time && !(o->T_lb > 0 && o->T_ub >= o->T_lb))) {
-    snprintf(err, errsz, "go_gait_create: at most %d muscles; a cost-of-transport goal needs a "
-             "speed; free time needs 0 < T_lb <= T_ub (equal: Ipopt fixes T)", GO_GAIT_MAX_MUSCLES);
-    go_gait_free(g);
+    snprintf(err, (size_t)errsz, "go_gait_create: at most %d muscles; a cost-of-transport goal "
+             "needs a speed; free time needs 0 < T_lb <= T_ub (equal: Ipopt fixes T)",
+             GO_GAIT_MAX_MUSCLES);
     return -1;
   }
   if (!(o->metabolic_smoothing > 0 && isfinite(o->metabolic_smoothing))) {
-    snprintf(err, errsz, "go_gait_create: metabolic_smoothing must be > 0");
-    go_gait_free(g);
+    snprintf(err, (size_t)errsz, "go_gait_create: metabolic_smoothing must be > 0");
     return -1;
   }
+  if (o->fibre_bounds && !(o->fibre_lo >= 0 && o->fibre_hi > o->fibre_lo)) {
+    snprintf(err, (size_t)errsz, "go_gait_create: fibre bounds need 0 <= fibre_lo < fibre_hi");
+    return -1;
+  }
+  if (o->min_vgrf > 0 && !(o->min_vgrf < 10)) {
+    snprintf(err, (size_t)errsz, "go_gait_create: min_vgrf must be below 10 body weights");
+    return -1;
+  }
+  return 0;
+}
+
+// the private model copy (constraint stage off), stride time, weight, speed
+static int setup_model(go_gait* g, const mjModel* m0, const go_gait_opts* o, char* err,
+                       int errsz) {
+  g->m = mj_copyModel(NULL, m0);
+  if (!g->m) return out_of_memory(err, errsz, "model copy");
+  g->m->opt.disableflags |= mjDSBL_CONSTRAINT;
+  g->N = o->N;
+  g->T = o->T > 0 ? o->T
+                  : (o->coords ? o->coords->time[o->coords->nrow - 1] - o->coords->time[0] : 1.0);
+  g->weight = mj_getTotalmass(g->m) * mju_norm3(g->m->opt.gravity);
+  g->speed = o->speed > 0 ? o->speed : 0;
+  g->nthreads = o->nthreads;
+  g->free_time = o->free_time;
+  return 0;
+}
+
+// muscle, activation and metabolic parameters, the elastic-tendon muscles
+static int setup_muscles(go_gait* g, const go_gait_opts* o, char* err, int errsz) {
+  const mjModel* m = g->m;
+  int na = m->na;
   // cost of transport: integrand w_cot Edot / (m V); with J = I / T that is w_cot COT
   g->cot_scale = o->w_cot > 0 ? o->w_cot / (mj_getTotalmass(m) * g->speed) : 0;
   g->umus = (gsUmbergerMuscle*)zalloc((size_t)na, sizeof(gsUmbergerMuscle));
+  g->mprm = (gsMuscleParams*)zalloc((size_t)na, sizeof(gsMuscleParams));
+  g->aprm = (gsActivationParams*)zalloc((size_t)na, sizeof(gsActivationParams));
+  g->elastic = (int*)zalloc((size_t)na, sizeof(int));
+  g->elastic_of = (int*)zalloc((size_t)na, sizeof(int));
+  if (!g->umus || !g->mprm || !g->aprm || !g->elastic || !g->elastic_of)
+    return out_of_memory(err, errsz, "muscles");
   gs_umberger_smoothing_default(&g->umb_smooth);
   g->umb_smooth.w_excitation *= o->metabolic_smoothing;
   g->umb_smooth.w_length *= o->metabolic_smoothing;
@@ -962,18 +999,11 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   for (int i = 0; i < na; i++) {
     if (gs_umberger_muscle_from_user(m->actuator_user + i * m->nuser_actuator, &g->umus[i], NULL,
                                      0) != 0 && g->cot_scale > 0) {
-      snprintf(err, errsz, "go_gait_create: actuator %s has no metabolic parameters",
+      snprintf(err, (size_t)errsz, "go_gait_create: actuator %s has no metabolic parameters",
                mj_id2name(m, mjOBJ_ACTUATOR, i));
-      go_gait_free(g);
       return -1;
     }
   }
-
-  // muscles
-  g->mprm = (gsMuscleParams*)zalloc((size_t)na, sizeof(gsMuscleParams));
-  g->aprm = (gsActivationParams*)zalloc((size_t)na, sizeof(gsActivationParams));
-  g->elastic = (int*)zalloc((size_t)na, sizeof(int));
-  g->elastic_of = (int*)zalloc((size_t)na, sizeof(int));
   int ne = 0;
   for (int i = 0; i < na; i++) {
     const double* user = m->actuator_user + i * m->nuser_actuator;
@@ -981,21 +1011,26 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
     if (!gs_actuator_is_gaitsim_muscle(m, i) ||
         gs_muscle_params_from_user(user, &g->mprm[i], why, sizeof(why)) != 0 ||
         gs_activation_params_from_user(user, &g->aprm[i], why, sizeof(why)) != 0) {
-      snprintf(err, errsz, "go_gait_create: actuator %s is not a valid gaitsim muscle",
+      snprintf(err, (size_t)errsz, "go_gait_create: actuator %s is not a valid gaitsim muscle",
                mj_id2name(m, mjOBJ_ACTUATOR, i));
-      go_gait_free(g);
       return -1;
     }
     g->elastic_of[i] = g->mprm[i].elastic ? ne : -1;
     if (g->mprm[i].elastic) g->elastic[ne++] = i;
   }
+  g->L.ne = ne;
+  return 0;
+}
 
-  // layout: the ground reaction moments are variables (and rows) only when tracked
+// where everything sits in z_k and in the path rows (go_gait_layout); the ground reaction
+// moments are variables (and rows) only when tracked
+static int setup_layout(go_gait* g, const go_gait_opts* o, char* err, int errsz) {
+  const mjModel* m = g->m;
   go_gait_layout* L = &g->L;
+  int nv = m->nv, na = m->na, ne = L->ne;
   L->ngrf = o->grf && o->w_grm > 0 ? GO_GAIT_NGRF : GO_GAIT_GRM_OFFSET;
   L->nv = nv;
   L->na = na;
-  L->ne = ne;
   L->nx = 2 * nv + na + ne;
   L->x_q = 0;
   L->x_qd = nv;
@@ -1016,21 +1051,11 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   L->n_path = 2 * nv + ne + na + L->ngrf;
   L->r_fib = -1;
   if (o->fibre_bounds) {
-    if (!(o->fibre_lo >= 0 && o->fibre_hi > o->fibre_lo)) {
-      snprintf(err, errsz, "go_gait_create: fibre bounds need 0 <= fibre_lo < fibre_hi");
-      go_gait_free(g);
-      return -1;
-    }
     L->r_fib = L->n_path;
     L->n_path += na;
   }
   L->r_walk = -1;
   if (o->min_vgrf > 0) {
-    if (!(o->min_vgrf < 10)) {
-      snprintf(err, errsz, "go_gait_create: min_vgrf must be below 10 body weights");
-      go_gait_free(g);
-      return -1;
-    }
     L->r_walk = L->n_path;
     L->n_path += 1;
   }
@@ -1040,19 +1065,23 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   int jtx = mj_name2id(m, mjOBJ_JOINT, "pelvis_tx");
   if (jtx >= 0) L->tx = m->jnt_dofadr[jtx];
   if (g->speed > 0 && L->tx < 0) {
-    snprintf(err, errsz, "go_gait_create: a speed constraint needs a pelvis_tx coordinate");
-    go_gait_free(g);
+    snprintf(err, (size_t)errsz, "go_gait_create: a speed constraint needs a pelvis_tx coordinate");
     return -1;
   }
-  int nz = L->nz;
+  return 0;
+}
 
-  // structure: crossing, mass matrix branches, foot chains
-  int* qcol = (int*)zalloc((size_t)nv, sizeof(int));
-  coord_columns(m, o->coords, qcol);
+// structure: which dofs each muscle crosses, mass matrix branches, foot chains, and the path
+// pattern they give (columns x_a and beyond analytic)
+static int setup_structure(go_gait* g, const go_gait_opts* o, const int* qcol, char* err,
+                           int errsz) {
+  const mjModel* m = g->m;
+  int nv = m->nv, na = m->na, nz = g->L.nz;
   g->cross = (unsigned char*)zalloc((size_t)na * nv, 1);
   g->tree = (unsigned char*)zalloc((size_t)nv * nv, 1);
   g->foot = (unsigned char*)zalloc((size_t)2 * nv, 1);
-  crossing(g, o->coords, qcol);
+  if (!g->cross || !g->tree || !g->foot || crossing(g, o->coords, qcol) != 0)
+    return out_of_memory(err, errsz, "structure");
   for (int a = 0; a < nv; a++) {
     for (int b = 0; b < nv; b++) {
       g->tree[a * nv + b] = dof_ancestor(m, a, b) || dof_ancestor(m, b, a);
@@ -1070,21 +1099,28 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   int nnz = pattern(g, NULL, NULL);
   g->col_ptr = (int*)zalloc((size_t)nz + 1, sizeof(int));
   g->row_idx = (int*)zalloc((size_t)nnz, sizeof(int));
-  pattern(g, g->col_ptr, g->row_idx);
   g->analytic = (unsigned char*)zalloc((size_t)nz, 1);
-  for (int c = L->x_a; c < nz; c++) {
+  if (!g->col_ptr || !g->row_idx || !g->analytic) return out_of_memory(err, errsz, "pattern");
+  pattern(g, g->col_ptr, g->row_idx);
+  for (int c = g->L.x_a; c < nz; c++) {
     g->analytic[c] = 1;
   }
+  return 0;
+}
 
-  // references and tracking weights
+// the measured data at the node times, the tracking weights and the integrand's variables
+static int setup_tracking(go_gait* g, const go_gait_opts* o, const int* qcol, char* err,
+                          int errsz) {
+  const mjModel* m = g->m;
+  const go_gait_layout* L = &g->L;
+  int nv = L->nv, na = L->na, nz = L->nz;
   g->q_ref = (double*)zalloc((size_t)g->N * nv, sizeof(double));
   g->grf_ref = (double*)zalloc((size_t)g->N * GO_GAIT_NGRF, sizeof(double));
   g->q_wt = (double*)zalloc((size_t)nv, sizeof(double));
-  if (references(g, o, qcol, err, errsz) != 0) {
-    free(qcol);
-    go_gait_free(g);
-    return -1;
-  }
+  g->ivars = (int*)zalloc((size_t)nz, sizeof(int));
+  if (!g->q_ref || !g->grf_ref || !g->q_wt || !g->ivars)
+    return out_of_memory(err, errsz, "tracking data");
+  if (references(g, o, qcol, err, errsz) != 0) return -1;
   int count[3] = {0, 0, 0};  // pelvis rotations, pelvis translations, others
   for (int j = 0; j < nv; j++) {
     if (qcol[j] < 0) continue;
@@ -1104,11 +1140,10 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   for (int c = 0; c < GO_GAIT_NGRF; c++) {
     int moment = c >= GO_GAIT_GRM_OFFSET;
     double w = moment ? o->w_grm : o->w_grf, sc = moment ? grm_sc : grf_sc;
-    g->grf_wt[c] = o->grf && w > 0 && c < g->L.ngrf ? w / (sc * sc) / g->L.ngrf : 0;
+    g->grf_wt[c] = o->grf && w > 0 && c < L->ngrf ? w / (sc * sc) / L->ngrf : 0;
   }
   g->w_effort = o->w_effort / na;
   g->w_accel = o->w_accel > 0 ? o->w_accel / (GO_GAIT_ACCEL_SCALE * GO_GAIT_ACCEL_SCALE) / nv : 0;
-  g->ivars = (int*)zalloc((size_t)nz, sizeof(int));
   for (int j = 0; j < nv; j++) {
     if (g->q_wt[j] > 0) g->ivars[g->n_ivars++] = L->x_q + j;
   }
@@ -1126,11 +1161,22 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   if (g->w_accel > 0) {
     for (int j = 0; j < nv; j++) g->ivars[g->n_ivars++] = L->xd_qdd + j;
   }
+  return 0;
+}
 
-  // bounds and scales
+// variable bounds and scales, path row scales and bounds
+static int setup_bounds(go_gait* g, const go_gait_opts* o, char* err, int errsz) {
+  const mjModel* m = g->m;
+  const go_gait_layout* L = &g->L;
+  int nv = L->nv, na = L->na, ne = L->ne, nz = L->nz;
   g->z_lb = (double*)zalloc((size_t)nz, sizeof(double));
   g->z_ub = (double*)zalloc((size_t)nz, sizeof(double));
   g->z_scale = (double*)zalloc((size_t)nz, sizeof(double));
+  g->path_scale = (double*)zalloc((size_t)L->n_path, sizeof(double));
+  g->path_lb = (double*)zalloc((size_t)L->n_path, sizeof(double));
+  g->path_ub = (double*)zalloc((size_t)L->n_path, sizeof(double));
+  if (!g->z_lb || !g->z_ub || !g->z_scale || !g->path_scale || !g->path_lb || !g->path_ub)
+    return out_of_memory(err, errsz, "bounds");
   for (int j = 0; j < nv; j++) {
     int jnt = m->dof_jntid[j];
     int slide = m->jnt_type[jnt] == mjJNT_SLIDE;
@@ -1182,7 +1228,6 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
     g->z_ub[L->u_grf + c] = 10 * g->weight;
     g->z_scale[L->u_grf + c] = g->weight;
   }
-  g->path_scale = (double*)zalloc((size_t)L->n_path, sizeof(double));
   for (int j = 0; j < nv; j++) {
     g->path_scale[L->r_link + j] = SC_QD;
     g->path_scale[L->r_eom + j] = g->weight;  // m g x 1 m (N m), or N for slides
@@ -1190,8 +1235,6 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   for (int e = 0; e < ne; e++) g->path_scale[L->r_hill + e] = 1;
   for (int i = 0; i < na; i++) g->path_scale[L->r_act + i] = SC_ADOT;
   for (int c = 0; c < L->ngrf; c++) g->path_scale[L->r_grf + c] = g->weight;
-  g->path_lb = (double*)zalloc((size_t)L->n_path, sizeof(double));
-  g->path_ub = (double*)zalloc((size_t)L->n_path, sizeof(double));
   for (int i = 0; L->r_fib >= 0 && i < na; i++) {
     g->path_scale[L->r_fib + i] = 1;  // lM / lopt: O(1)
     g->path_lb[L->r_fib + i] = o->fibre_lo;
@@ -1202,9 +1245,16 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
     g->path_lb[L->r_walk] = o->min_vgrf * g->weight;
     g->path_ub[L->r_walk] = 1e19;  // none (scale_bound: Ipopt's infinity)
   }
+  return 0;
+}
 
-  // boundary: periodic states (but pelvis_tx and free coordinates), excitations, speed
-  unsigned char* periodic = (unsigned char*)zalloc((size_t)nz, 1);
+// boundary rows and their pattern: periodic states (but pelvis_tx and free coordinates),
+// excitations, speed; periodic (nz) is scratch
+static int setup_boundary(go_gait* g, const go_gait_opts* o, unsigned char* periodic, char* err,
+                          int errsz) {
+  const mjModel* m = g->m;
+  const go_gait_layout* L = &g->L;
+  int na = L->na, nz = L->nz;
   if (o->periodic) {
     for (int v = 0; v < L->nx; v++) periodic[v] = 1;
     for (int i = 0; i < na; i++) periodic[L->u_e + i] = 1;
@@ -1212,11 +1262,8 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
     for (int f = 0; o->free_coords && o->free_coords[f]; f++) {
       int jnt = mj_name2id(m, mjOBJ_JOINT, o->free_coords[f]);
       if (jnt < 0) {
-        snprintf(err, errsz, "go_gait_create: free coordinate %s is not in the model",
+        snprintf(err, (size_t)errsz, "go_gait_create: free coordinate %s is not in the model",
                  o->free_coords[f]);
-        free(periodic);
-        free(qcol);
-        go_gait_free(g);
         return -1;
       }
       periodic[L->x_q + m->jnt_dofadr[jnt]] = 0;
@@ -1230,6 +1277,10 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   g->bnd_col_ptr = (int*)zalloc((size_t)2 * nz + 2, sizeof(int));
   g->bnd_row_idx = (int*)zalloc((size_t)2 * g->n_bnd + 2, sizeof(int));
   int* row_of = (int*)zalloc((size_t)nz, sizeof(int));
+  if (!g->bnd_var || !g->bnd_scale || !g->bnd_col_ptr || !g->bnd_row_idx || !row_of) {
+    free(row_of);
+    return out_of_memory(err, errsz, "boundary");
+  }
   nb = 0;
   for (int v = 0; v < nz; v++) {
     row_of[v] = -1;
@@ -1255,28 +1306,33 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   if (g->free_time && g->speed > 0) g->bnd_row_idx[nbe++] = nb;  // speed row: T column
   g->bnd_col_ptr[2 * nz + 1] = nbe;
   free(row_of);
-  free(periodic);
-  free(qcol);
+  return 0;
+}
 
-  // worker contexts
+// worker contexts: one mjData and scratch per engine worker
+static int setup_workers(go_gait* g, char* err, int errsz) {
+  int nv = g->L.nv, na = g->L.na, nz = g->L.nz;
   g->ctx = (gait_ctx*)zalloc((size_t)g->nthreads, sizeof(gait_ctx));
   g->ctx_ptr = (void**)zalloc((size_t)g->nthreads, sizeof(void*));
+  if (!g->ctx || !g->ctx_ptr) return out_of_memory(err, errsz, "workers");
   for (int w = 0; w < g->nthreads; w++) {
     g->ctx[w].g = g;
-    g->ctx[w].d = mj_makeData(m);
+    g->ctx[w].d = mj_makeData(g->m);
     g->ctx[w].M = (double*)zalloc((size_t)nv * nv, sizeof(double));
     g->ctx[w].P = (double*)zalloc((size_t)na, sizeof(double));
     g->ctx[w].Pm = (double*)zalloc((size_t)na, sizeof(double));
     g->ctx[w].zp = (double*)zalloc((size_t)nz, sizeof(double));
     g->ctx_ptr[w] = &g->ctx[w];
-    if (!g->ctx[w].d || !g->ctx[w].M || !g->ctx[w].P || !g->ctx[w].Pm || !g->ctx[w].zp) {
-      snprintf(err, errsz, "go_gait_create: out of memory");
-      go_gait_free(g);
-      return -1;
-    }
+    if (!g->ctx[w].d || !g->ctx[w].M || !g->ctx[w].P || !g->ctx[w].Pm || !g->ctx[w].zp)
+      return out_of_memory(err, errsz, "workers");
   }
+  return 0;
+}
 
-  // the NLP
+// the NLP (go_collocation.h) with eq. 3's band as bound overrides, and the Hessian elements
+static int setup_nlp(go_gait* g, const go_gait_opts* o, char* err, int errsz) {
+  const go_gait_layout* L = &g->L;
+  int nv = L->nv, na = L->na, nz = L->nz;
   go_problem p;
   memset(&p, 0, sizeof(p));
   p.dims = (go_dims){g->N, L->nx, na + L->ngrf, L->n_path, g->n_bnd, g->free_time};
@@ -1289,6 +1345,7 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   // eq. 3 of Lin, Walter & Pandy 2018: q and qdot within a band around a given solution
   if (o->band_z) {
     g->band = (go_bound_override*)zalloc((size_t)4 * g->N * nv, sizeof(go_bound_override));
+    if (!g->band) return out_of_memory(err, errsz, "band");
     for (int k = 0; k < g->N; k++) {
       const double* zk = o->band_z + (size_t)k * nz;
       for (int j = 0; j < nv; j++) {
@@ -1326,12 +1383,38 @@ int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char
   p.bnd_row_idx = g->bnd_row_idx;
   p.thread_ctx = g->ctx_ptr;
   p.nthreads = g->nthreads;
-  if (go_nlp_create(&g->nlp, &p, err, errsz) != 0) {
-    go_gait_free(g);
-    return -1;
+  if (go_nlp_create(&g->nlp, &p, err, errsz) != 0) return -1;
+  if (build_elements(g) != 0) return out_of_memory(err, errsz, "Hessian elements");
+  return 0;
+}
+
+int go_gait_create(go_gait** out, const mjModel* m0, const go_gait_opts* o, char* err,
+                   int errsz) {
+  *out = NULL;
+  if (check_inputs(m0, o, err, errsz) != 0) return -1;
+  go_gait* g = (go_gait*)calloc(1, sizeof(go_gait));
+  if (!g) return out_of_memory(err, errsz, "problem");
+  // scratch of the phases: the coordinate column of each dof (nv), the periodic variables (nz)
+  int* qcol = NULL;
+  unsigned char* periodic = NULL;
+  int rc = setup_model(g, m0, o, err, errsz);
+  if (rc == 0) rc = setup_muscles(g, o, err, errsz);
+  if (rc == 0) rc = setup_layout(g, o, err, errsz);
+  if (rc == 0) {
+    qcol = (int*)zalloc((size_t)g->L.nv, sizeof(int));
+    periodic = (unsigned char*)zalloc((size_t)g->L.nz, 1);
+    if (!qcol || !periodic) rc = out_of_memory(err, errsz, "scratch");
+    else coord_columns(g->m, o->coords, qcol);
   }
-  if (build_elements(g) != 0) {
-    snprintf(err, (size_t)errsz, "go_gait: out of memory (Hessian elements)");
+  if (rc == 0) rc = setup_structure(g, o, qcol, err, errsz);
+  if (rc == 0) rc = setup_tracking(g, o, qcol, err, errsz);
+  if (rc == 0) rc = setup_bounds(g, o, err, errsz);
+  if (rc == 0) rc = setup_boundary(g, o, periodic, err, errsz);
+  if (rc == 0) rc = setup_workers(g, err, errsz);
+  if (rc == 0) rc = setup_nlp(g, o, err, errsz);
+  free(qcol);
+  free(periodic);
+  if (rc != 0) {
     go_gait_free(g);
     return -1;
   }

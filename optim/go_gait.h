@@ -162,10 +162,10 @@ typedef struct {
 
 typedef struct go_gait go_gait;
 
-// defaults: N 40, 1 thread, T from coords, w_pelvis_rot 1, w_pelvis_trans 1, w_joint 1, w_grf 1,
-// w_grm 0,
-// w_effort 0.1, w_accel 0, periodic 1, no free coordinates, no speed constraint; no prediction
-// (w_cot 0, fixed time, no band, no fibre bounds; fibre_lo 0.25, fibre_hi 1.5; min_vgrf 0)
+// defaults: N GO_NODES_TRACK (go_defaults.h), 1 thread, T from coords, w_pelvis_rot 1,
+// w_pelvis_trans 1, w_joint 1, w_grf 1, w_grm 0, w_effort 0.1, w_accel 0, periodic 1, no free
+// coordinates, no speed constraint; no prediction (w_cot 0, fixed time, no band, no fibre
+// bounds; fibre_lo 0.25, fibre_hi 1.5; min_vgrf 0)
 void go_gait_opts_default(go_gait_opts* opts);
 
 // Build the problem for model m (prepared by gs_physics_prepare; every actuator must be a gaitsim
@@ -181,6 +181,7 @@ go_nlp* go_gait_nlp(go_gait* g);
 const go_gait_layout* go_gait_layout_get(const go_gait* g);
 const mjModel* go_gait_model(const go_gait* g);
 int go_gait_nodes(const go_gait* g);
+int go_gait_threads(const go_gait* g);     // engine workers
 double go_gait_stride_time(const go_gait* g);
 double go_gait_weight(const go_gait* g);   // body weight m g (N)
 

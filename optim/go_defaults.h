@@ -1,0 +1,82 @@
+// go_defaults.h: the one table of gaitsim's solve defaults, read by go_gait_opts_default,
+// go_solve_plan_default and every command (track, predict, sweep, run) and by their --help texts
+// (GO_STR makes the text from the value, so a default is written once). Plain literals only:
+// GO_STR(GO_NODES_TRACK) is the string "80".
+#ifndef GAITSIM_OPTIM_GO_DEFAULTS_H_
+#define GAITSIM_OPTIM_GO_DEFAULTS_H_
+
+#define GO_STR_(x) #x
+#define GO_STR(x) GO_STR_(x)  // the text of a default, e.g. GO_STR(GO_NODES_TRACK) "80"
+
+// collocation nodes per stride (-)
+#define GO_NODES_TRACK 80     // gaitsim track, and go_gait_opts_default: the paper's resolution
+                              // (Lin, Walter & Pandy 2018)
+#define GO_NODES_PREDICT 20   // gaitsim predict and sweep (each prediction of a sweep)
+#define GO_NODES_MAIN_JOB 20  // gaitsim run's main job (its tracking solve, then its sweep): the
+                              // main job's resolution until 80-node solves converge in its time
+                              // budget (issue #19); more nodes are solved on this many first and
+                              // continued
+// worker threads of one solve (-)
+#define GO_THREADS 2
+// Ipopt iteration limits (-)
+#define GO_MAX_ITER 1000           // track and predict (--max-iter)
+#define GO_MAX_ITER_SWEEP 1500     // each prediction of sweep and of run's main job: an
+                                   // iteration budget, not a time limit, so results do not
+                                   // depend on the load of the machine
+#define GO_MAX_ITER_MAIN_TRACK 600     // run's tracking solve on GO_NODES_MAIN_JOB nodes
+#define GO_MAX_ITER_MAIN_CONTINUED 1000  // run's tracking solve continued on more nodes
+// initial activations and excitations of a guess from the trial or a solution's states (-)
+#define GO_ACTIVATION 0.05
+// fall-back guard (go_ipopt_opts.fallback_rise, fallback_viol): stop when the objective rises by
+// more than GO_FALLBACK_RISE (fraction, -) above the lowest one reached at a scaled violation
+// <= GO_FALLBACK_VIOL (the acceptable level's), and restart from the best iterate, at most
+// GO_MAX_RESTARTS times (go_solve.h)
+#define GO_FALLBACK_RISE 0.25
+#define GO_FALLBACK_VIOL 1e-4
+#define GO_MAX_RESTARTS 2
+// exact-Hessian refinement of an L-BFGS tracking solve that stopped short (go_solve.h): at most
+// GO_REFINE_ITER Newton iterations (-) and GO_REFINE_WALL_S seconds of wall clock. From the main
+// job's 600-iteration N = 20 solution they reached Ipopt's acceptable level after 78 (238 s,
+// 2 threads), J -3.8 % (docs/BENCHMARKS.md, "Exact-Hessian refinement of the tracking solve");
+// at N = 80 one exact-Hessian iteration costs about 4 times the N = 20 one
+#define GO_REFINE_ITER 150
+#define GO_REFINE_WALL_S 600
+// feasibility polish (go_solve.h): Gauss-Newton iterations at most (-), and its wall-clock cap
+// after a stop signal (s)
+#define GO_POLISH_ITER 200
+#define GO_STOP_POLISH_S 30
+
+// goal weights of gaitsim track (go_gait_opts.w_*, -); go_gait_opts_default keeps its own
+// unit weights for library callers
+#define GO_TRACK_W_PELVIS_ROT 10
+#define GO_TRACK_W_PELVIS_TRANS 10
+#define GO_TRACK_W_JOINT 1
+#define GO_TRACK_W_GRF 10
+#define GO_TRACK_W_GRM 0     // off: 10 narrows the stance to the measured one but, at 600
+                             // iterations, worsens pelvis, GRF and knee tracking
+                             // (docs/BENCHMARKS.md, 2026-12-02)
+#define GO_TRACK_W_EFFORT 50  // 0.1 left mean activation at 0.37 (co-contraction); issue #6 note
+#define GO_TRACK_W_ACCEL 0    // none (results stay as they were)
+// gaitsim predict's regularisation weights (-): effort, the mean squared excitation; accel, the
+// mean squared acceleration (qddot / 50)^2: at the tracking solution results/track (peak |qddot|
+// 500 rad/s^2, the variable bound) the goal is 0.26 against J = 178; after 40 iterations at
+// 0.8 m/s (polished) it cut RMS qddot from 62 to 45 and the peak from 353 to 183 rad/s^2 at
+// 0.06 % of J (1: 23 and 113, 0.13 %); small enough not to move the cost of transport
+#define GO_PREDICT_W_EFFORT 0.01
+#define GO_PREDICT_W_ACCEL 0.1
+// gaitsim predict's factor on the smooth Umberger 2010 widths (-): with the widths of
+// gs_umberger_smoothing_default (steps 0.01 wide in u - a, lM~ - 1 and v~ in lopt/s) no full-body
+// prediction reached Ipopt's stopping test in up to 1500 L-BFGS iterations; 10 times wider, 0.8
+// m/s reached the acceptable level after 477 and 2.0 m/s the optimal solution after 993 from the
+// same tracking solution, and the exact (unsmoothed) cost of transport of the solution differs by
+// 1.8 % (docs/BENCHMARKS.md, 2026-12-02); 3 times wider did not converge in 1000 at 0.8 m/s
+#define GO_PREDICT_METABOLIC_SMOOTHING 10
+// gaitsim predict's floor on the summed vertical ground reaction of both feet at every node
+// (BW): no flight phase. Not in the paper; without it, 20-node solves at 2.0 m/s found a gait
+// with 2 of 20 nodes in flight (2.5 BW peaks) and a bouncing one with flight at 3 nodes and a
+// 75 % longer stride, cheaper than the walks; with it the same guess gave a walk (double support
+// at 2 nodes, lowest summed force 0.22 BW). Human walking keeps it above about 0.4 BW even at
+// 2 m/s (docs/BENCHMARKS.md, "Walking: a floor on the vertical ground reaction")
+#define GO_PREDICT_MIN_VGRF 0.2
+
+#endif  // GAITSIM_OPTIM_GO_DEFAULTS_H_

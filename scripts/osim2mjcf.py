@@ -13,7 +13,7 @@ surrogates (fit_path_wraps). Deterministic: the same inputs give the same bytes.
 Usage:
   /usr/bin/python3 scripts/osim2mjcf.py --osim PATH --muscle-params DIR \
       --out mjmodels/jw_fullbody.xml --reference-out mjmodels/reference/jw_moment_arms.csv \
-      [--trial-ik PATH]
+      [--trial-ik PATH] [--knee-params mjmodels/knee/jw_knee.json] [--wrap-report]
 """
 import argparse
 import csv

@@ -111,7 +111,8 @@ int go_static_opt_solve(int n, int m, const double* B, const double* c, double w
                         double hi, double* a);
 
 // 1 if dof j of model m is matched by the static optimisation (not a root dof, no joint
-// spring), else 0.
+// spring, not one of the six-DOF implant knee's secondary dofs, which its contact surrogate and
+// ligaments hold), else 0.
 int go_static_dof_matched(const mjModel* m, int j);
 
 // What the static guess found, over all nodes.

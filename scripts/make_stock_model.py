@@ -89,12 +89,6 @@ FOOT_BODIES = ("calcaneus", "toes", "calcaneus_l", "toes_l")  # carry the fitted
 # fitted range (hard landings, a collapsing body) it stops the foot sinking further
 STOP_DEPTH = 0.012
 SEGMENT_SOLREF = "0.002 1"  # time constant 2 ms (2 timesteps, the stable minimum), critical damping
-# damping of every hinge but the pelvis' (N m s/rad) where the source sets none: stands in for
-# gaitsim's fibre damping (0.01 Fmax at vmax, callbacks/gs_muscle.h), which MuJoCo's muscle lacks;
-# summed over the muscles crossing a joint, 0.01 Fmax / vmax r^2 is of order 0.1-1 N m s/rad.
-# Without it a limb that the collapsing body leaves in the air swings undamped (the left foot
-# about subtalar_angle_l at 0.8 rad/s after 5 s; mjmodels/README.md, jw_fullbody_mujoco.xml)
-JOINT_DAMPING = 0.3
 
 
 def fmt(x):
@@ -375,12 +369,6 @@ def main():
         fits.append(rms)
         if rms > worst[0]:
             worst = (rms, el.get("name"))
-
-    # joint damping (JOINT_DAMPING)
-    for j in root.find("./worldbody").iter("joint"):
-        if j.get("type") == "hinge" and not j.get("name").startswith("pelvis") \
-                and j.get("damping") is None:
-            j.set("damping", fmt(JOINT_DAMPING))
 
     # contact: fitted solref/solimp per foot sphere; elliptic cone
     iw = invweight0(args.source)

@@ -7,13 +7,12 @@ reference table of muscle-tendon lengths and moment arms computed from the OpenS
 alone (CustomJoint kinematics, path points incl. conditional and moving points; straight
 segments, and with OpenSim's wrapping re-implemented: wrapped_path) for the project's C test.
 
-Standard library, plus scipy/numpy (Debian python3-scipy) for the least-squares fit of the wrap
-surrogates (fit_path_wraps). Deterministic: the same inputs give the same bytes.
+Standard library only. Deterministic: the same inputs give the same bytes.
 
 Usage:
   /usr/bin/python3 scripts/osim2mjcf.py --osim PATH --muscle-params DIR \
       --out mjmodels/jw_fullbody.xml --reference-out mjmodels/reference/jw_moment_arms.csv \
-      [--trial-ik PATH] [--knee-params mjmodels/knee/jw_knee.json] [--wrap-report]
+      [--trial-ik PATH]
 """
 import argparse
 import csv
@@ -1687,465 +1686,6 @@ def assign_wraps(model, muscle, kept_points, x0):
     return {s: (v[1], v[2]) for s, v in best.items()}
 
 
-
-def default_wrap(body, w):
-    """The default surrogate of a wrap object as a path element ("wrap", body, spec, sidesite
-    location or None): wrap_geom_spec at the object's place, shared by every muscle that uses
-    the object; OpenSim's quadrant -> a sidesite 1.5 radii (ellipsoid: 1.5 largest semi-axes)
-    out along that axis."""
-    spec = wrap_geom_spec(body, w)
-    spec["name"] = w["name"]
-    spec["pos"] = w["translation"]
-    d = quadrant_direction(w)
-    side = None
-    if d is not None:
-        reach = 1.5 * max(spec["radius"], max(w["dimensions"]) if w["type"] == "WrapEllipsoid"
-                          else spec["radius"])
-        side = tf_point((w["rotation"], w["translation"]), vec_scale(d, reach))
-    return ("wrap", body, spec, side)
-
-
-# ------------------------------------------------------------------------------------------------
-# MuJoCo 2.2's tendon wrapping in Python (for fitting the wrap surrogates)
-# ------------------------------------------------------------------------------------------------
-# A port of mju_wrap / wrap_circle / length_circle / is_intersect (google-deepmind/mujoco,
-# src/engine/engine_util_misc.c, Apache-2.0) and of mj_tendon's spatial-tendon length (site -
-# wrap geom - site: straight if the wrap reports no wrap). The sidesite-inside case (wrap_inside)
-# is not ported: the converter never puts a sidesite inside its geom (checked, mujoco_wrap).
-# tests/test_model_moment_arms.c evaluates the written model with MuJoCo itself.
-
-MJ_MINVAL = 1e-15        # MuJoCo's mjMINVAL
-
-
-def _is_intersect(p1, p2, p3, p4):
-    """Do the 2-D segments p1-p2 and p3-p4 intersect (is_intersect)."""
-    det = (p4[1] - p3[1]) * (p2[0] - p1[0]) - (p4[0] - p3[0]) * (p2[1] - p1[1])
-    if abs(det) < MJ_MINVAL:
-        return False
-    a = ((p4[0] - p3[0]) * (p1[1] - p3[1]) - (p4[1] - p3[1]) * (p1[0] - p3[0])) / det
-    b = ((p2[0] - p1[0]) * (p1[1] - p3[1]) - (p2[1] - p1[1]) * (p1[0] - p3[0])) / det
-    return 0.0 <= a <= 1.0 and 0.0 <= b <= 1.0
-
-
-def _unit2(v):
-    n = math.hypot(v[0], v[1])
-    return [1.0, 0.0] if n < MJ_MINVAL else [v[0] / n, v[1] / n]
-
-
-def _wrap_circle(d, sd, rad):
-    """2-D circle wrap (wrap_circle): d = (x0, y0, x1, y1) about a circle of radius rad at the
-    origin, sd the side point on the circle or None. Returns (tangent points, arc length) or
-    None (no wrap)."""
-    sqlen0 = d[0] * d[0] + d[1] * d[1]
-    sqlen1 = d[2] * d[2] + d[3] * d[3]
-    sqrad = rad * rad
-    dif = (d[2] - d[0], d[3] - d[1])
-    if sqlen0 < sqrad or sqlen1 < sqrad or rad < MJ_MINVAL:
-        return None
-    dd = dif[0] * dif[0] + dif[1] * dif[1]
-    if dd < MJ_MINVAL:
-        return None
-    a = min(1.0, max(0.0, -(dif[0] * d[0] + dif[1] * d[1]) / dd))
-    tmp = (a * dif[0] + d[0], a * dif[1] + d[1])
-    if tmp[0] * tmp[0] + tmp[1] * tmp[1] > sqrad and (
-            sd is None or sd[0] * tmp[0] + sd[1] * tmp[1] >= 0.0):
-        return None
-    sols, good = [], []
-    sqrt0 = math.sqrt(sqlen0 - sqrad)
-    sqrt1 = math.sqrt(sqlen1 - sqrad)
-    for i in range(2):
-        sgn = 1.0 if i == 0 else -1.0
-        s0 = ((d[0] * sqrad + sgn * rad * d[1] * sqrt0) / sqlen0,
-              (d[1] * sqrad - sgn * rad * d[0] * sqrt0) / sqlen0)
-        s1 = ((d[2] * sqrad - sgn * rad * d[3] * sqrt1) / sqlen1,
-              (d[3] * sqrad + sgn * rad * d[2] * sqrt1) / sqlen1)
-        if sd is not None:
-            t = _unit2((s0[0] + s1[0], s0[1] + s1[1]))
-            g = t[0] * sd[0] + t[1] * sd[1]
-        else:
-            g = -((s0[0] - s1[0]) ** 2 + (s0[1] - s1[1]) ** 2)
-        if _is_intersect(d[0:2], s0, d[2:4], s1):
-            g = -10000.0
-        sols.append((s0, s1))
-        good.append(g)
-    i = 0 if good[0] > good[1] else 1
-    s0, s1 = sols[i]
-    if _is_intersect(d[0:2], s0, d[2:4], s1):
-        return None
-    # length_circle
-    n0, n1 = _unit2(s0), _unit2(s1)
-    angle = math.acos(max(-1.0, min(1.0, n0[0] * n1[0] + n0[1] * n1[1])))
-    cross = s0[1] * s1[0] - s0[0] * s1[1]
-    if (cross > 0 and i == 1) or (cross < 0 and i == 0):
-        angle = 2.0 * math.pi - angle
-    return (s0, s1), rad * angle
-
-
-def mujoco_wrap(x0, x1, frame, kind, radius, side):
-    """mju_wrap: the segment x0-x1 (world points) about a sphere or cylinder (kind) of the given
-    radius with world frame (R, p) (cylinder axis = the frame's z, infinitely long as in MuJoCo),
-    side = world position of the sidesite or None. Returns (tangent point 0, tangent point 1,
-    wrap length) in the world, or None (no wrap)."""
-    rot, org = frame
-    rt = mat_t(rot)
-    p0 = mat_vec(rt, vec_sub(x0, org))
-    p1 = mat_vec(rt, vec_sub(x1, org))
-    if vec_norm(p0) < MJ_MINVAL or vec_norm(p1) < MJ_MINVAL:
-        return None
-    if kind == "sphere":
-        ax0 = unit(p0)
-        normal = cross3(p0, p1)
-        if vec_norm(normal) < MJ_MINVAL:
-            raise ValueError("mujoco_wrap: sphere wrap with parallel end points")
-        normal = unit(normal)
-        ax1 = unit(cross3(normal, ax0))
-    else:
-        ax0, ax1 = [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]
-    d = (dot3(p0, ax0), dot3(p0, ax1), dot3(p1, ax0), dot3(p1, ax1))
-    sd = None
-    if side is not None:
-        s = mat_vec(rt, vec_sub(side, org))
-        sd = (dot3(s, ax0), dot3(s, ax1))
-        n = math.hypot(sd[0], sd[1])
-        if n < radius:
-            raise ValueError("mujoco_wrap: sidesite inside its wrap geom (wrap_inside not ported)")
-        sd = (sd[0] / n * radius, sd[1] / n * radius)
-    res = _wrap_circle(d, sd, radius)
-    if res is None:
-        return None
-    (s0, s1), wlen = res
-    r0 = vec_add(vec_scale(ax0, s0[0]), vec_scale(ax1, s0[1]))
-    r1 = vec_add(vec_scale(ax0, s1[0]), vec_scale(ax1, s1[1]))
-    if kind == "cylinder":
-        l0 = math.hypot(p0[0] - r0[0], p0[1] - r0[1])
-        l1 = math.hypot(p1[0] - r1[0], p1[1] - r1[1])
-        r0[2] = p0[2] + (p1[2] - p0[2]) * l0 / (l0 + wlen + l1)
-        r1[2] = p0[2] + (p1[2] - p0[2]) * (l0 + wlen) / (l0 + wlen + l1)
-        wlen = math.hypot(wlen, r1[2] - r0[2])
-    return vec_add(mat_vec(rot, r0), org), vec_add(mat_vec(rot, r1), org), wlen
-
-
-def mujoco_path_length(elements, x):
-    """Length of a MuJoCo spatial tendon at body transforms x: elements alternate
-    ("site", body, location) and optional ("wrap", body, spec, side) between two sites, spec =
-    {"type", "radius", "pos", "rot"} in the body frame, side = a location in that body or None."""
-    length = 0.0
-    prev = None
-    pending = None
-    for e in elements:
-        if e[0] == "wrap":
-            pending = e
-            continue
-        pt = tf_point(x[e[1]], e[2])
-        if prev is not None:
-            hit = None
-            if pending is not None:
-                _, body, spec, side = pending
-                frame = tf_mul(x[body], (spec["rot"], spec["pos"]))
-                hit = mujoco_wrap(prev, pt, frame, spec["type"], spec["radius"],
-                                  None if side is None else tf_point(x[body], side))
-            if hit is None:
-                length += vec_norm(vec_sub(pt, prev))
-            else:
-                length += vec_norm(vec_sub(hit[0], prev)) + hit[2] + vec_norm(vec_sub(pt, hit[1]))
-        prev = pt
-        pending = None
-    return length
-
-
-# ------------------------------------------------------------------------------------------------
-# wrap surrogates fitted to OpenSim's wrapped paths
-# ------------------------------------------------------------------------------------------------
-
-WRAP_TOL_LENGTH = 0.005    # length tolerance against the wrapped reference             (m)
-WRAP_TOL_ARM = 0.005       # moment-arm tolerance: the larger of this                     (m/rad)
-WRAP_TOL_REL = 0.15        # ... and this fraction of |r_ref|                              (-)
-WRAP_FIT_TARGET = 0.7      # a surrogate is fitted where its error exceeds this share of the tolerance
-WRAP_FIT_FRAMES = 18       # fit poses: the reference poses plus every 18th trial frame ...
-WRAP_FIT_FROM = 9          # ... from this one (not on a raised branch, raised_frames)
-WRAP_CHECK_FRAMES = 3      # --wrap-report: every 3rd trial frame (from 1)
-WRAP_SIDE_REACH = 1.5      # fitted sidesites sit this many radii from the wrap centre     (-)
-WRAP_RADIUS_STARTS = (0.6, 1.0)    # radius scales the fit starts from                     (-)
-WRAP_SHIFT_START = 0.5     # ... and centre shifts across the geom (in radii, +-x, +-y)    (-)
-WRAP_REFINE = 8            # starts refined by least squares (the best by initial cost)
-WRAP_HINGE = 0.9           # the fit pushes every normalised error below this ...           (-)
-WRAP_HINGE_WEIGHT = 3.0    # ... with a hinge residual of this weight                        (-)
-
-
-def primary_coordinates(model, muscle):
-    """The crossed coordinates a moment arm is asserted for (not the right knee's secondary)."""
-    return [c for c in crossed_coordinates(model, muscle) if c not in KNEE_SECONDARY]
-
-
-def wrap_fit_poses(model, muscle, poses, methods):
-    """Per pose: body transforms at the pose and at +-FD_STEP of each primary coordinate, and
-    the wrapped reference (length, moment arms) with its tolerance."""
-    coords = primary_coordinates(model, muscle)
-    out = []
-    for pose in poses:
-        states = [model.pose_state(pose)[1]]
-        for c in coords:
-            for h in (FD_STEP, -FD_STEP):
-                p = dict(pose)
-                p[c] += h
-                states.append(model.pose_state(p)[1])
-        arms = wrapped_moment_arms(model, muscle, pose, coords, methods)
-        ref = [wrapped_path(model, muscle, pose, methods)[0]] + [arms[c] for c in coords]
-        tol = [WRAP_TOL_LENGTH] + [max(WRAP_TOL_ARM, WRAP_TOL_REL * abs(r)) for r in ref[1:]]
-        out.append((states, ref, tol))
-    return out
-
-
-def surrogate_errors(elements, fit_poses):
-    """(model - reference) / tolerance of the length and primary moment arms at every pose."""
-    out = []
-    for states, ref, tol in fit_poses:
-        ls = [mujoco_path_length(elements, x) for x in states]
-        vals = [ls[0]] + [-(ls[1 + 2 * i] - ls[2 + 2 * i]) / (2 * FD_STEP)
-                          for i in range(len(ref) - 1)]
-        out.extend((v - r) / t for v, r, t in zip(vals, ref, tol))
-    return out
-
-
-# rotations taking a cylinder's local z to an ellipsoid's axis k (columns: geom x, y, z in the
-# wrap object's frame)
-AXIS_TO_Z = {0: [[0, 0, 1], [0, 1, 0], [-1, 0, 0]],
-             1: [[1, 0, 0], [0, 0, 1], [0, -1, 0]],
-             2: IDENTITY}
-
-
-def surrogate_shapes(w):
-    """Shapes a wrap object may be represented by: (kind, rotation object -> geom frame, radius,
-    drawn half-length). WrapCylinder: itself; WrapEllipsoid: a cylinder along each semi-axis
-    (radius the mean of the two others; MuJoCo's wrapping cylinder is infinitely long, the
-    half-length only draws it) and a sphere of the mean semi-axis; WrapSphere: itself."""
-    if w["type"] == "WrapCylinder":
-        return [("cylinder", IDENTITY, w["radius"], w["length"] / 2.0)]
-    if w["type"] == "WrapSphere":
-        return [("sphere", IDENTITY, w["radius"], 0.0)]
-    dims = w["dimensions"]
-    out = [("cylinder", AXIS_TO_Z[k], (sum(dims) - dims[k]) / 2.0, dims[k]) for k in range(3)]
-    out.append(("sphere", IDENTITY, sum(dims) / 3.0, 0.0))
-    return out
-
-
-def side_directions(kind):
-    """Sidesite directions in the geom frame: none, or for a cylinder one of its axes across the
-    wrap (x, y). A sphere gets none: its sidesite projects into the wrapping plane, where it may
-    fall inside the circle (MuJoCo's wrap_inside, not ported)."""
-    out = [None]
-    if kind != "cylinder":
-        return out
-    for k in range(2):
-        for s in (1.0, -1.0):
-            d = [0.0, 0.0, 0.0]
-            d[k] = s
-            out.append(d)
-    return out
-
-
-def surrogate_wrap(cand, params):
-    """("wrap", body, spec, side) of a candidate with params = (offset of the centre in the wrap
-    object's frame (m, 3), log of the radius scale)."""
-    w = cand["object"]
-    rot = mat_mul(w["rotation"], cand["to_geom"])
-    pos = vec_add(w["translation"], mat_vec(w["rotation"], list(params[0:3])))
-    radius = cand["radius0"] * math.exp(params[3])
-    side = None
-    if cand["side"] is not None:
-        side = vec_add(pos, vec_scale(mat_vec(rot, cand["side"]), WRAP_SIDE_REACH * radius))
-    spec = {"type": cand["kind"], "radius": radius, "half": cand["half"], "pos": pos, "rot": rot,
-            "name": w["name"], "fitted": True}
-    return ("wrap", cand["body"], spec, side)
-
-
-def fit_surrogate(template, cand_lists, fit_poses):
-    """Choose and fit the wraps of a path: template is the path's element list in which
-    ("slot", k) stands for the k-th wrap to choose and ("via", body, location) for a via site
-    whose location is fitted too; cand_lists[k] lists slot k's candidates (None: no wrap). Every
-    combination starts from each radius scale; the WRAP_REFINE best by initial sum of squared
-    normalised errors (over fit_poses) are refined by least squares (scipy: the errors plus a
-    hinge that pushes each one below WRAP_HINGE). Returns (elements, chosen candidates, parameters,
-    largest normalised error) of the refined start with the smallest largest error."""
-    import itertools
-    import numpy as np
-    from scipy.optimize import least_squares
-
-    nvia = sum(1 for e in template if e[0] == "via")
-
-    def build(combo, p):
-        out, k, v = [], 0, 0
-        for e in template:
-            if e[0] == "slot":
-                if combo[e[1]] is not None:
-                    out.append(surrogate_wrap(combo[e[1]], p[4 * e[1]:4 * e[1] + 4]))
-            elif e[0] == "via":
-                off = 4 * len(combo) + 3 * v
-                out.append(("site", e[1], vec_add(e[2], list(p[off:off + 3])), e[3]))
-                v += 1
-            else:
-                out.append(e)
-        return out
-
-    def errors(combo, p):
-        return np.array(surrogate_errors(build(combo, p), fit_poses))
-
-    def start_params(c, s, shift):
-        if c is None:
-            return [0.0, 0.0, 0.0, 0.0]
-        d = [0.0, 0.0, 0.0]
-        if shift is not None:
-            d[shift[0]] = shift[1] * WRAP_SHIFT_START * c["radius0"]
-        return mat_vec(c["to_geom"], d) + [math.log(s)]
-
-    shifts = [None, (0, 1.0), (0, -1.0), (1, 1.0), (1, -1.0)]
-    starts = []
-    for n, combo in enumerate(itertools.product(*cand_lists)):
-        seen = set()
-        for s in WRAP_RADIUS_STARTS:
-            for shift in shifts:
-                p = sum((start_params(c, s, shift) for c in combo), []) + [0.0] * (3 * nvia)
-                if tuple(p) in seen:
-                    continue
-                seen.add(tuple(p))
-                starts.append((float(np.sum(errors(combo, p) ** 2)), n, combo, p))
-    starts.sort(key=lambda t: (t[0], t[1]))
-    best = None
-    for _, _, combo, p in starts[:WRAP_REFINE]:
-        free = [i for i in range(len(p)) if i >= 4 * len(combo) or combo[i // 4] is not None]
-        scale = np.array([0.3 if i < 4 * len(combo) and i % 4 == 3 else 0.01 for i in free])
-
-        def full(q, p=p, free=free):
-            x = list(p)
-            for i, v in zip(free, q):
-                x[i] = float(v)
-            return x
-
-        def res(q, combo=combo, full=full):
-            e = errors(combo, full(q))
-            return np.concatenate([e, WRAP_HINGE_WEIGHT * np.maximum(0.0, np.abs(e) - WRAP_HINGE)])
-        x = p
-        if free:
-            sol = least_squares(res, np.array([p[i] for i in free]), x_scale=scale,
-                                diff_step=1e-5, max_nfev=300)
-            x = full(sol.x)
-        worst = float(np.max(np.abs(errors(combo, x))))
-        if best is None or worst < best[3]:
-            best = (build(combo, x), combo, x, worst)
-    return best
-
-
-def wrap_candidates(body, w):
-    """Every shape and sidesite a wrap object may be represented by (fit_surrogate)."""
-    return [{"body": body, "object": w, "kind": kind, "to_geom": rot, "radius0": r, "half": h,
-             "side": d}
-            for kind, rot, r, h in surrogate_shapes(w) for d in side_directions(kind)]
-
-
-def segment_objects(muscle, kept, objects):
-    """{segment s (kept[s] - kept[s + 1]): [(body, wrap object)]} of the PathWraps whose point
-    range contains the segment, in PathWrap order."""
-    out = {}
-    for pw in muscle["wraps"]:
-        lo, hi = pw["range"]
-        for s in range(len(kept) - 1):
-            i0, i1 = kept[s][0], kept[s + 1][0]
-            if lo > 0 and not (i0 + 1 >= lo and i1 + 1 <= hi):
-                continue
-            if objects[pw["object"]] not in out.setdefault(s, []):
-                out[s].append(objects[pw["object"]])
-    return out
-
-
-def with_segment(elements, first, last, middle):
-    """elements with everything between the sites named first and last replaced by middle."""
-    names = [e[3] if e[0] == "site" else None for e in elements]
-    a, b = names.index(first), names.index(last)
-    return elements[:a + 1] + middle + elements[b:]
-
-
-def fit_path_wraps(muscle, kept, elements, objects, x0, fit_poses):
-    """MuJoCo wraps for a muscle's path (mjmodels/README.md, "Fitted wrap surrogates"): the
-    default surrogate (elements) where its largest error over fit_poses is within
-    WRAP_FIT_TARGET of the tolerance; else, per segment in turn, the wrap (object, shape,
-    sidesite, centre, radius) or none that fits best (fit_surrogate); where that still misses and
-    a segment has two wrap objects, the segment is split by a fitted via site on either object's
-    body, with one fitted wrap on each side. Returns (elements, largest normalised error,
-    [description of each change])."""
-    worst = max(abs(e) for e in surrogate_errors(elements, fit_poses))
-    notes = []
-    if worst <= WRAP_FIT_TARGET:
-        return elements, worst, notes
-    names = ["%s-P%d" % (muscle["name"], i + 1) for i, _, _ in kept]
-    segs = segment_objects(muscle, kept, objects)
-    for s in sorted(segs):
-        cands = [None] + sum((wrap_candidates(b, w) for b, w in segs[s]), [])
-        template = with_segment(elements, names[s], names[s + 1], [("slot", 0)])
-        elems, combo, p, w = fit_surrogate(template, [cands], fit_poses)
-        if w < worst:
-            worst, elements = w, elems
-            notes.append((s, combo, p, None))
-    for s in sorted(segs):
-        if worst <= WRAP_FIT_TARGET or len(segs[s]) < 2:
-            continue
-        a = tf_point(x0[kept[s][1]["body"]], kept[s][2])
-        b = tf_point(x0[kept[s + 1][1]["body"]], kept[s + 1][2])
-        ab = vec_sub(b, a)
-
-        def along(obj):
-            c = tf_point(x0[obj[0]], obj[1]["translation"])
-            return dot3(vec_sub(c, a), ab) / dot3(ab, ab)
-        first, second = sorted(segs[s][:2], key=along)
-        mid = vec_add(a, vec_scale(ab, 0.5 * (along(first) + along(second))))
-        for vb in sorted({first[0], second[0]}):
-            via = ("via", vb, tf_point(tf_inv(x0[vb]), mid), "%s-V%d" % (muscle["name"], s + 1))
-            template = with_segment(elements, names[s], names[s + 1],
-                                    [("slot", 0), via, ("slot", 1)])
-            elems, combo, p, w = fit_surrogate(
-                template, [[None] + wrap_candidates(*first), [None] + wrap_candidates(*second)],
-                fit_poses)
-            if w < worst:
-                worst, elements = w, elems
-                notes.append((s, combo, p, vb))
-    # fitted wraps are the muscle's own geoms
-    out = []
-    for e in elements:
-        if e[0] == "wrap" and e[2].get("fitted"):
-            e = ("wrap", e[1], dict(e[2], name="%s_%s" % (muscle["name"], e[2]["name"])), e[3])
-        out.append(e)
-    return out, worst, notes
-
-
-WRAP_JUMP = 0.003          # a jump of OpenSim's wrapped-minus-straight length between
-                           # adjacent trial frames above this marks a raised branch          (m)
-
-
-def raised_frames(model, muscle, frames, methods):
-    """Trial frames where OpenSim's wrapped path is on a raised branch (mjmodels/README.md,
-    "Raised branches"): the excess length (wrapped - straight) is split into runs of frames at
-    jumps above WRAP_JUMP between adjacent frames; a run, other than the longest, that every
-    bounding jump enters upwards and leaves downwards is raised. A taut path cannot lengthen by
-    several mm within one frame (8 ms) and shorten back: these are OpenSim's wrapping plane or
-    tangent point switching branch (an end point on or near the ellipsoid's surface). Returns a
-    list of booleans, one per frame."""
-    ex = [wrapped_path(model, muscle, pose, methods)[0] - path_length(model, muscle, pose)
-          for _, pose in frames]
-    cuts = [i for i in range(1, len(ex)) if abs(ex[i] - ex[i - 1]) > WRAP_JUMP]
-    bounds = [0] + cuts + [len(ex)]
-    runs = [(bounds[k], bounds[k + 1]) for k in range(len(bounds) - 1)]
-    longest = max(range(len(runs)), key=lambda k: (runs[k][1] - runs[k][0], -k))
-    raised = [False] * len(ex)
-    for k, (a, b) in enumerate(runs):
-        enter = a > 0
-        leave = b < len(ex)
-        if k == longest or not (enter or leave):
-            continue
-        if (not enter or ex[a] > ex[a - 1]) and (not leave or ex[b - 1] > ex[b]):
-            for i in range(a, b):
-                raised[i] = True
-    return raised
-
-
 # ------------------------------------------------------------------------------------------------
 # the converter
 # ------------------------------------------------------------------------------------------------
@@ -2656,8 +2196,7 @@ def standing_pose(model, zero, frames, soles):
 
 
 class Converter:
-    def __init__(self, model, metabolic, frames, osim_name, heel_strikes, grf_path, meshes,
-                 methods):
+    def __init__(self, model, metabolic, frames, osim_name, heel_strikes, grf_path, meshes):
         self.model = model
         self.meshes = meshes     # body -> [(mesh, scale, class)] (display_meshes)
         self.metabolic = metabolic
@@ -2686,10 +2225,7 @@ class Converter:
         self.sites = {}          # body -> [(site name, pos)]
         self.wrap_geoms = {}     # body -> [wrap geom spec]
         self.tendons = []        # (muscle, [elements])
-        self.notes = {"moving": [], "conditional": []}
-        self.methods = methods   # muscle -> PathWrap methods (read_wrap_methods)
-        self.raised = {}         # wrapping muscle -> raised_frames
-        self.wrap_fits = []      # (muscle, default elements, elements, worst, changes)
+        self.notes = {"moving": [], "conditional": [], "dropped_wraps": []}
 
     # --- bodies ------------------------------------------------------------------------------
 
@@ -2700,15 +2236,7 @@ class Converter:
         return {"patella": "tibial_tray", "patella_l": "tibia_l"}.get(body)
 
     def build_paths(self):
-        """Sites, wrap geoms and tendon elements of every muscle. Wrapping muscles start from the
-        default surrogate (assign_wraps, default_wrap) and get fitted wraps where it misses
-        OpenSim's wrapped path (fit_path_wraps; mjmodels/README.md, "Fitted wrap surrogates")."""
         m = self.model
-        objects = {}
-        for b in m.body_order:
-            for w in m.bodies[b]["wraps"]:
-                objects[w["name"]] = (b, w)
-        ref_idx = reference_poses(self.frames)
         for mus in m.muscles:
             kept = []
             for i, p in enumerate(mus["points"]):
@@ -2724,49 +2252,47 @@ class Converter:
                 else:
                     loc = p["location"]
                 kept.append((i, p, loc))
-            seg_wraps = assign_wraps(m, mus, kept, self.x0)
             elements = []
+            seg_wraps = assign_wraps(m, mus, kept, self.x0)
+            for wp in mus["wraps"]:
+                if wp["object"] not in [w["name"] for (_, w) in seg_wraps.values()]:
+                    self.notes["dropped_wraps"].append((mus["name"], wp["object"]))
             for s, (i, p, loc) in enumerate(kept):
-                elements.append(("site", p["body"], loc, "%s-P%d" % (mus["name"], i + 1)))
+                site = "%s-P%d" % (mus["name"], i + 1)
+                self.sites.setdefault(p["body"], []).append((site, loc))
+                elements.append(("site", site))
                 if s in seg_wraps:
-                    elements.append(default_wrap(*seg_wraps[s]))
-            if mus["wraps"]:
-                raised = raised_frames(m, mus, self.frames, self.methods)
-                self.raised[mus["name"]] = raised
-                fit_idx = [i for i in ref_idx if not raised[i]] + [
-                    i for i in range(WRAP_FIT_FROM, len(self.frames), WRAP_FIT_FRAMES)
-                    if not raised[i] and i not in ref_idx]
-                fit_poses = wrap_fit_poses(m, mus, [self.frames[i][1] for i in fit_idx],
-                                           self.methods)
-                default = elements
-                elements, worst, changes = fit_path_wraps(mus, kept, elements, objects,
-                                                          self.x0, fit_poses)
-                self.wrap_fits.append((mus["name"], default, elements, worst, changes))
-            self.tendons.append((mus, self.register_path(elements)))
+                    body, w = seg_wraps[s]
+                    geom = self.wrap_geom_name(body, w)
+                    side = self.side_site(body, w)
+                    elements.append(("geom", geom, side))
+            self.tendons.append((mus, elements))
 
-    def register_path(self, elements):
-        """Add a path's sites and wrap geoms to their bodies; returns the tendon's elements
-        (("site", name) or ("geom", name, sidesite name or None))."""
-        out = []
-        for e in elements:
-            if e[0] == "site":
-                lst = self.sites.setdefault(e[1], [])
-                if e[3] not in [x[0] for x in lst]:
-                    lst.append((e[3], e[2]))
-                out.append(("site", e[3]))
-                continue
-            _, body, spec, side = e
-            lst = self.wrap_geoms.setdefault(body, [])
-            if spec["name"] not in [x["name"] for x in lst]:
-                lst.append(spec)
-            side_name = None
-            if side is not None:
-                side_name = spec["name"] + "_side"
-                sites = self.sites.setdefault(body, [])
-                if side_name not in [x[0] for x in sites]:
-                    sites.append((side_name, side))
-            out.append(("geom", spec["name"], side_name))
-        return out
+    def wrap_geom_name(self, body, w):
+        lst = self.wrap_geoms.setdefault(body, [])
+        if w["name"] not in [x["name"] for x in lst]:
+            spec = wrap_geom_spec(body, w)
+            spec["name"] = w["name"]
+            spec["pos"] = w["translation"]
+            spec["quadrant"] = quadrant_direction(w)
+            spec["orig_rot"] = w["rotation"]
+            lst.append(spec)
+        return w["name"]
+
+    def side_site(self, body, w):
+        """Sidesite outside the wrap surface in OpenSim's quadrant direction (none for 'all')."""
+        d = quadrant_direction(w)
+        if d is None:
+            return None
+        spec = [x for x in self.wrap_geoms[body] if x["name"] == w["name"]][0]
+        reach = 1.5 * max(spec["radius"], max(w["dimensions"]) if w["type"] == "WrapEllipsoid"
+                          else spec["radius"])
+        pos = tf_point((w["rotation"], w["translation"]), vec_scale(d, reach))
+        name = w["name"] + "_side"
+        lst = self.sites.setdefault(body, [])
+        if name not in [s[0] for s in lst]:
+            lst.append((name, pos))
+        return name
 
     # --- writing -----------------------------------------------------------------------------
 
@@ -2881,18 +2407,6 @@ class Converter:
         out.append("    GRF of its grf.mot): mjmodels/README.md, Contact spheres and standing pose.")
         out.append("  Display meshes (visual only, no mass, no collision): meshes/, made by")
         out.append("    scripts/make_bone_meshes.py; provenance and licence in meshes/README.md.")
-        fitted = [f for f in self.wrap_fits if f[4]]
-        out.append("  Wrap geoms: OpenSim's wrap objects as MuJoCo cylinders and spheres; for %d"
-                   % len(fitted))
-        words = [f[0] for f in fitted]
-        while words:
-            out.append("    " + " ".join(words[:10]))
-            words = words[10:]
-        out.append("    the wraps (object, shape, sidesite, centre, radius, via sites) are fitted")
-        out.append("    by scipy least squares to the length and moment arms of OpenSim's wrapped")
-        out.append("    path (the converter's port) at the reference poses and every %dth trial"
-                   % WRAP_FIT_FRAMES)
-        out.append("    frame of IK_ngait_og5: mjmodels/README.md, Fitted wrap surrogates.")
         out.append("  Layout of actuator and geom user rows: callbacks/gs_model_layout.h;")
         out.append("    choices and errors: mjmodels/README.md.")
         out.append("-->")
@@ -2996,13 +2510,12 @@ class Converter:
         write_atomic(path, "\n".join(out) + "\n")
 
 
-def write_reference(model, frames, path, poses_path, osim_name, trial_name, methods, raised):
+def write_reference(model, frames, path, poses_path, osim_name, trial_name, methods):
     """The moment-arm reference (mjmodels/README.md, "Moment-arm comparison"): per pose, muscle
     and crossed coordinate the straight-line value (value, as before), and OpenSim's wrapped
     value (value_wrap: wrapped_path, for muscles without wrap objects the same path), both by
     central differences; wrapping = 1 where OpenSim's path touches a wrap object at the pose.
-    methods: read_wrap_methods of the .osim; raised: {muscle: raised_frames} (column raised).
-    """
+    methods: read_wrap_methods of the .osim."""
     idx = reference_poses(frames)
     lines = []
     lines.append("# GENERATED by %s (do not edit): muscle-tendon lengths and moment arms of %s"
@@ -3021,12 +2534,9 @@ def write_reference(model, frames, path, poses_path, osim_name, trial_name, meth
                  "misses every wrap object of the muscle")
     lines.append("# (normalised clearance >= 1, see wrap_clearance; constrained quadrants respected). "
                  "wrapping = 1 if OpenSim's wrapped path touches")
-    lines.append("# a wrap object at this pose (then value_wrap differs from value). raised = 1 if "
-                 "OpenSim's wrapped path is on a raised branch at this pose")
-    lines.append("# (entered and left by jumps of the wrapped-minus-straight length > %g mm between "
-                 "adjacent trial frames; raised_frames in the converter)." % (1000 * WRAP_JUMP))
+    lines.append("# a wrap object at this pose (then value_wrap differs from value).")
     lines.append("# MuJoCo actuator_moment = dL/dq = -r.")
-    lines.append("pose,muscle,coordinate,value,wraps,clear,value_wrap,wrapping,raised")
+    lines.append("pose,muscle,coordinate,value,wraps,clear,value_wrap,wrapping")
     pose_lines = ["# GENERATED by %s: reference poses for jw_moment_arms.csv, frames of %s; "
                   "radians and m, model coordinate order" % (CONVERTER, trial_name),
                   "# pose: trial row (0-based), time (s): " + "; ".join(
@@ -3041,52 +2551,16 @@ def write_reference(model, frames, path, poses_path, osim_name, trial_name, meth
             clear = 1 if clearance is None or clearance >= 1.0 else 0
             length_wrap, touched = wrapped_path(model, mus, pose, methods)
             wrapping = 1 if touched else 0
-            up = 1 if mus["name"] in raised and raised[mus["name"]][i] else 0
-            lines.append("%d,%s,length,%s,%d,%d,%s,%d,%d" % (
+            lines.append("%d,%s,length,%s,%d,%d,%s,%d" % (
                 k, mus["name"], fmt(path_length(model, mus, pose), 10), wraps, clear,
-                fmt(length_wrap, 10), wrapping, up))
+                fmt(length_wrap, 10), wrapping))
             crossed = crossed_coordinates(model, mus)
             arms_wrap = wrapped_moment_arms(model, mus, pose, crossed, methods)
             for c, r in moment_arms(model, mus, pose, crossed).items():
-                lines.append("%d,%s,%s,%s,%d,%d,%s,%d,%d" % (
-                    k, mus["name"], c, fmt(r, 8), wraps, clear, fmt(arms_wrap[c], 8), wrapping,
-                    up))
+                lines.append("%d,%s,%s,%s,%d,%d,%s,%d" % (k, mus["name"], c, fmt(r, 8), wraps,
+                                                         clear, fmt(arms_wrap[c], 8), wrapping))
     write_atomic(path, "\n".join(lines) + "\n")
     write_atomic(poses_path, "\n".join(pose_lines) + "\n")
-
-
-def wrap_report(model, frames, conv, methods):
-    """--wrap-report: per wrapping muscle, the largest |L - L_wrap| (mm) and |r - r_wrap| (mm,
-    primary coordinates) of the default and the fitted surrogate against OpenSim's wrapped path
-    at the reference poses and at every WRAP_CHECK_FRAMES-th trial frame (frames on a raised
-    branch left out and counted), and the largest normalised error at those frames."""
-    ref_idx = reference_poses(frames)
-    check = list(range(1, len(frames), WRAP_CHECK_FRAMES))
-    print("| muscle | raised frames | default dL / dr at ref. poses (mm) | fitted dL / dr | "
-          "gait frames: dL / dr (mm), largest error / tolerance |")
-    print("|---|---|---|---|---|")
-    for name, default, fitted, _, _ in conv.wrap_fits:
-        mus = [x for x in model.muscles if x["name"] == name][0]
-        raised = conv.raised[name]
-
-        def worst(elements, idx):
-            fp = wrap_fit_poses(model, mus, [frames[i][1] for i in idx], methods)
-            dl = dr = norm = 0.0
-            for (states, ref, tol) in fp:
-                e = surrogate_errors(elements, [(states, ref, tol)])
-                dl = max(dl, abs(e[0]) * tol[0])
-                dr = max([dr] + [abs(v) * t for v, t in zip(e[1:], tol[1:])])
-                norm = max([norm] + [abs(v) for v in e])
-            return dl, dr, norm
-        ref_ok = [i for i in ref_idx if not raised[i]]
-        d0 = worst(default, ref_ok)
-        d1 = worst(fitted, ref_ok)
-        g = worst(fitted, [i for i in check if not raised[i]])
-        print("| %s | %d of %d%s | %.2f / %.2f | %.2f / %.2f | %.2f / %.2f, %.2f |" % (
-            name, sum(raised), len(frames),
-            "" if len(ref_ok) == len(ref_idx) else " (%d ref. poses)" % (len(ref_idx) - len(ref_ok)),
-            1000 * d0[0], 1000 * d0[1], 1000 * d1[0], 1000 * d1[1], 1000 * g[0], 1000 * g[1],
-            g[2]))
 
 
 def add_knee_params(xml_path, params_path):
@@ -3128,10 +2602,6 @@ def main():
         "trial.json"), help="trial.json of scripts/prepare_trial.py: the heel strikes (source "
                             "times) that place the heel spheres; grf.mot next to it is fitted "
                             "(default: the bundled trial's)")
-    ap.add_argument("--wrap-report", action="store_true",
-                    help="print each wrapping muscle's largest length and moment-arm errors "
-                         "against OpenSim's wrapped path, default and fitted surrogate, at the "
-                         "reference poses and every %dth trial frame (slow)" % WRAP_CHECK_FRAMES)
     args = ap.parse_args()
     heel_strikes = read_heel_strikes(args.trial_events)
     trial = args.trial_ik or os.path.join(os.path.dirname(os.path.abspath(args.osim)), "..",
@@ -3152,10 +2622,9 @@ def main():
     # display meshes: meshes/ next to the model (its meshdir)
     meshes = display_meshes(args.osim, os.path.join(os.path.dirname(os.path.abspath(args.out)),
                                                     "meshes"))
-    methods = read_wrap_methods(args.osim)
     conv = Converter(model, metabolic, frames, os.path.basename(args.osim), heel_strikes,
                      os.path.join(os.path.dirname(os.path.abspath(args.trial_events)), "grf.mot"),
-                     meshes, methods)
+                     meshes)
     for side in ("r", "l"):
         sole = conv.soles[side]
         print("sole %s: normal %s, offset %.4f m in the calcaneus frame (%d foot-flat frames, "
@@ -3176,14 +2645,10 @@ def main():
     conv.write(args.out)
     if args.knee_params:
         add_knee_params(args.out, args.knee_params)
-    for name, _, _, worst, changes in conv.wrap_fits:
-        print("wraps %-11s largest error %.2f of the tolerance%s" % (
-            name, worst, "" if changes else " (default surrogate)"))
     write_reference(model, frames, args.reference_out,
                     os.path.join(os.path.dirname(args.reference_out), "jw_poses.csv"),
-                    os.path.basename(args.osim), os.path.basename(trial), methods, conv.raised)
-    if args.wrap_report:
-        wrap_report(model, frames, conv, methods)
+                    os.path.basename(args.osim), os.path.basename(trial),
+                    read_wrap_methods(args.osim))
     print("wrote %s (%d dof, %d muscles, %.4f kg) and %s" % (
         args.out, len(MODEL_COORDINATES), len(model.muscles),
         sum(b["mass"] for b in model.bodies.values()), args.reference_out))

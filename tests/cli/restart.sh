@@ -7,8 +7,7 @@
 # exit 3 with the status "fell back from the solution it had reached", two restarts in
 # summary.json in order (each after more iterations than the one before, each from an iteration
 # no later than its stop, with the objective and violation of the best iterate it started from,
-# violation <= 1e-3: the best-iterate ranking's limit, go_ipopt_opts.best_viol_tol; with the
-# fitted wrap paths of gait2d.xml the two restarts start from 2.7e-4 and 4.8e-4), the iterations of all three solves summed, the polished result feasible to
+# violation <= 1e-3: the best-iterate ranking's limit, go_ipopt_opts.best_viol_tol), the iterations of all three solves summed, the polished result feasible to
 # 1e-6, and the progress naming both restarts; --fallback-rise with a negative value is a usage
 # error (exit 2).
 # usage: restart.sh GAITSIM SOURCE_DIR

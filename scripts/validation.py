@@ -77,7 +77,8 @@ def tracking(track):
     s = load_summary(track)
     rms = s.get("rms", {})
     trial = s.get("trial", "")
-    print(f"## Tracking: {trial}, {s.get('nodes')} nodes ({s.get('status')})\n")
+    print(f"## Tracking: {os.path.basename(os.path.normpath(trial)) if trial else '-'}, "
+          f"{s.get('nodes')} nodes ({s.get('status')})\n")
     print("Model RMS errors over the stride against the trial; the paper's Table 1 for the same "
           "participant (JW) beside them. Target (#20 item 6): every Table 1 figure met or beaten "
           "while knee contact stays <= 0.30 BW.\n")

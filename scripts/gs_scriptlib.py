@@ -5,9 +5,11 @@
 - write_atomic: write text (or bytes) to a temporary file in the target's folder, then rename
   over the target, so a crash never leaves half a file and an earlier file stays until the new one
   is whole.
+- read_json: a JSON object file (summary.json, trial.json) as a dict.
 - read_storage: an OpenSim storage file (.sto/.mot: header lines, endheader, a tab-separated label
   line, numeric rows) as (header lines, labels, rows).
 """
+import json
 import os
 import tempfile
 
@@ -42,6 +44,23 @@ def write_atomic(path, text):
         if os.path.exists(tmp):
             os.unlink(tmp)
         raise
+
+
+def read_json(path):
+    """The JSON object in path (a dict). Raises PrepError for a missing or unreadable file, text
+    that is not JSON, or JSON that is not an object."""
+    try:
+        with open(path, encoding="utf-8") as f:
+            obj = json.load(f)
+    except FileNotFoundError:
+        raise PrepError(path, "file not found")
+    except json.JSONDecodeError as e:
+        raise PrepError(path, f"not JSON ({e.msg}, line {e.lineno})")
+    except OSError as e:
+        raise PrepError(path, e.strerror or "cannot read")
+    if not isinstance(obj, dict):
+        raise PrepError(path, "not a JSON object")
+    return obj
 
 
 def read_storage(path):

@@ -18,22 +18,17 @@ Prints a Markdown table (figure, coarse, fine, difference, target, met) and the 
 of the four solves; the last line is "mesh_convergence: N of M targets met". Exit 0 when every
 target is met, 3 when one is missed, 1 on unreadable input (one line naming the file).
 """
-import json
 import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gs_scriptlib import PrepError, read_storage  # noqa: E402
+from gs_scriptlib import PrepError, read_json, read_storage  # noqa: E402
 
 
 def load(folder):
     path = os.path.join(folder, "summary.json")
-    try:
-        with open(path, encoding="utf-8") as f:
-            s = json.load(f)
-    except (OSError, ValueError) as e:
-        raise PrepError(path, getattr(e, "strerror", None) or str(e))
-    if not isinstance(s, dict) or not s.get("body_weight_n"):
+    s = read_json(path)
+    if not s.get("body_weight_n"):
         raise PrepError(path, "no body_weight_n")
     _, labels, rows = read_storage(os.path.join(folder, "grf.mot"))
     peaks = {}

@@ -71,7 +71,7 @@ import signal
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gs_scriptlib import PrepError, read_storage, write_atomic  # noqa: E402
+from gs_scriptlib import PrepError, read_json, read_storage, write_atomic  # noqa: E402
 
 SOURCE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DEFAULT_TRIAL = os.path.join(SOURCE_DIR, "mjmodels", "trials", "jw_ngait_og5")
@@ -165,21 +165,6 @@ class Storage:
         if name not in TRANSLATIONS and not self.in_degrees:
             a = a * 180.0 / math.pi
         return a
-
-
-def read_json(path):
-    try:
-        with open(path, encoding="utf-8") as f:
-            obj = json.load(f)
-    except FileNotFoundError:
-        raise PrepError(path, "file not found")
-    except json.JSONDecodeError as e:
-        raise PrepError(path, f"not JSON ({e.msg}, line {e.lineno})")
-    except OSError as e:
-        raise PrepError(path, e.strerror or "cannot read")
-    if not isinstance(obj, dict):
-        raise PrepError(path, "not a JSON object")
-    return obj
 
 
 def finite_number(v):

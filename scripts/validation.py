@@ -16,20 +16,18 @@ project's issues (#19 resolution, #20 physiology). Exit 1 with one line naming t
 input is missing.
 """
 import glob
-import json
 import math
 import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gs_scriptlib import PrepError, read_storage  # noqa: E402
+from gs_scriptlib import PrepError, read_json, read_storage  # noqa: E402
+from report import PAPER_MEASURED_STRIDE_TIME, PAPER_STRIDE_TIME, TABLE1  # noqa: E402
 
 CAL = 4.184             # J per cal
 BASAL_W_PER_KG = 1.2    # basal rate added to the model's muscle power for its gross cost (W/kg)
-PAPER_T1_P2 = {         # Lin, Walter & Pandy 2018, Table 1, participant 2 (JW)
-    "pelvis_rot_deg": 0.21, "pelvis_trans_cm": 0.20, "grf_ap_bw": 0.02, "grf_v_bw": 0.04,
-    "grf_ml_bw": 0.02, "joint_rot_deg": 1.98, "knee_contact_bw": 0.32}
-PAPER_STRIDE = {0.8: (1.30, 1.45), 2.0: (0.92, 0.93)}  # speed: (predicted, measured mean) (s)
+# speed (m/s): the paper's (predicted, measured mean) stride time (s), from the report's lists
+PAPER_STRIDE = {v: (t, dict(PAPER_MEASURED_STRIDE_TIME)[v]) for v, t in PAPER_STRIDE_TIME}
 KNEE_PEAK_LIMIT = {0.8: 2.8, 2.0: 3.5}                 # issue #20 item 5 (BW)
 
 
@@ -39,15 +37,6 @@ def ralston_gross_w_per_kg(v):
     return (29.0 + 0.0053 * vm * vm) * CAL / 60.0
 
 
-def load_summary(folder):
-    path = os.path.join(folder, "summary.json")
-    try:
-        with open(path, encoding="utf-8") as f:
-            return json.load(f)
-    except (OSError, ValueError) as e:
-        raise PrepError(path, getattr(e, "strerror", None) or str(e))
-
-
 def stance_cop_z(path):
     """Force-weighted mean mediolateral centre of pressure (m) of each foot over its stance
     (vertical force > 20 N): where each foot stands, from grf.mot."""
@@ -55,7 +44,8 @@ def stance_cop_z(path):
     out = {}
     for side in "rl":
         try:
-            fy, pz = labels.index(f"ground_force_{side}_vy"), labels.index(f"ground_force_{side}_pz")
+            fy = labels.index(f"ground_force_{side}_vy")
+            pz = labels.index(f"ground_force_{side}_pz")
         except ValueError:
             raise PrepError(path, f"no ground_force_{side}_vy / _pz columns")
         w = [(r[fy], r[pz]) for r in rows if r[fy] > 20.0]
@@ -66,7 +56,8 @@ def stance_cop_z(path):
 
 
 def fmt(v, digits=2):
-    return "-" if v is None or (isinstance(v, float) and not math.isfinite(v)) else f"{v:.{digits}f}"
+    missing = v is None or (isinstance(v, float) and not math.isfinite(v))
+    return "-" if missing else f"{v:.{digits}f}"
 
 
 def row(cells):
@@ -74,7 +65,7 @@ def row(cells):
 
 
 def tracking(track):
-    s = load_summary(track)
+    s = read_json(os.path.join(track, "summary.json"))
     rms = s.get("rms", {})
     trial = s.get("trial", "")
     print(f"## Tracking: {os.path.basename(os.path.normpath(trial)) if trial else '-'}, "
@@ -84,13 +75,12 @@ def tracking(track):
           "while knee contact stays <= 0.30 BW.\n")
     row(["figure", "model", "paper (Table 1, participant 2)", "met"])
     row(["---"] * 4)
-    names = [("pelvis_rot_deg", "pelvis rotations (deg)"), ("pelvis_trans_cm", "pelvis translations (cm)"),
-             ("grf_ap_bw", "GRF fore-aft (BW)"), ("grf_v_bw", "GRF vertical (BW)"),
-             ("grf_ml_bw", "GRF mediolateral (BW)"), ("joint_rot_deg", "other joint rotations (deg)"),
-             ("knee_contact_bw", "knee contact force, total (BW)")]
-    for key, label in names:
-        v, ref = rms.get(key), PAPER_T1_P2[key]
-        row([label, fmt(v, 3), fmt(ref), "yes" if v is not None and v <= ref else "no"])
+    for key, quantity, unit, paper in TABLE1:
+        if paper == "-":
+            continue
+        v, ref = rms.get(key), float(paper)
+        row([f"{quantity} ({unit})", fmt(v, 3), fmt(ref), "yes" if v is not None and v <= ref
+             else "no"])
     print()
     print("Knee contact against the implant's in-vivo measurement (eTibia, the trial's "
           "knee_contact.sto). Targets (#20 item 3): medial and lateral RMS each <= 0.30 BW, total "
@@ -119,7 +109,7 @@ def tracking(track):
 def predictions(folders):
     sums = []
     for f in folders:
-        s = load_summary(f)
+        s = read_json(os.path.join(f, "summary.json"))
         if s.get("problem") == "prediction":
             sums.append(s)
     if not sums:
@@ -147,7 +137,8 @@ def predictions(folders):
         lim = KNEE_PEAK_LIMIT.get(round(v, 1) if v else None)
         row([fmt(v, 1), f"{s.get('nodes')}, {s.get('status')}",
              fmt(T, 3) + (f" ({100 * (T / ref[1] - 1):+.1f} % of measured)" if ref and T else ""),
-             f"{ref[0]:.2f} / {ref[1]:.2f}" if ref else "-", fmt(cot), fmt(net), fmt(gross), fmt(ral),
+             f"{ref[0]:.2f} / {ref[1]:.2f}" if ref else "-", fmt(cot), fmt(net), fmt(gross),
+             fmt(ral),
              "yes" if gross is not None and abs(gross / ral - 1) <= 0.25 else "no",
              f"{fmt(kr)} / {fmt(kl)}",
              "-" if lim is None else ("yes" if max(kr, kl) <= lim else "no")])
@@ -182,9 +173,9 @@ def main(argv):
               "coordination and joint-contact loading in human gait. Ann Biomed Eng 46:1216: "
               "Table 1 (participant 2 is JW), predicted strides 1.30 / 0.92 s, measured means 1.45 "
               "/ 0.93 s.")
-        print("- Fregly BJ et al. (2012). Grand challenge competition to predict in vivo knee loads. "
-              "J Orthop Res 30:503-513: JW's instrumented tibial implant (eTibia), the trial's "
-              "knee_contact.sto.")
+        print("- Fregly BJ et al. (2012). Grand challenge competition to predict in vivo knee "
+              "loads. J Orthop Res 30:503-513: JW's instrumented tibial implant (eTibia), the "
+              "trial's knee_contact.sto.")
         print("- Ralston HJ (1958). Energy-speed relation and optimal speed during level walking. "
               "Int Z Angew Physiol 17:277-283: gross metabolic rate 29 + 0.0053 v^2 cal/(kg min), "
               f"v in m/min; the model's gross rate adds a basal {BASAL_W_PER_KG} W/kg to its "

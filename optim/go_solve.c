@@ -190,7 +190,7 @@ typedef struct {
   const go_solve_plan* p;   // the plan
   go_gait* g;               // its problem
   go_nlp* nlp;              // its NLP
-  int n, mm;                // variables, constraints
+  int n, mm, ne;            // variables, constraints, Jacobian nonzeros
   double* z;                // Ipopt's point (n, physical)
   double* zb;               // the best iterate (n, physical)
   double* zs;               // scratch: a stage's best iterate, scaled points (n)
@@ -368,12 +368,11 @@ static int run_stages(run_state* s, go_solve_report* rep, char* err, int errsz) 
   go_nlp_scale_z(s->nlp, p->z0, s->zs);
   rep->initial_violation =
       go_nlp_eval_g(s->nlp, s->zs, s->gv) == 0 ? go_nlp_violation(s->nlp, s->gv) : INFINITY;
-  int ne;
-  go_nlp_sizes(s->nlp, &s->n, &s->mm, &ne);
   if (f) {
     fprintf(f, "%s: %d nodes, %d variables, %d constraints, %d Jacobian nonzeros, %d colour "
             "groups, %d threads; initial violation %.3g\n", p->label, go_gait_nodes(s->g), s->n,
-            s->mm, ne, go_nlp_path_groups(s->nlp), go_gait_threads(s->g), rep->initial_violation);
+            s->mm, s->ne, go_nlp_path_groups(s->nlp), go_gait_threads(s->g),
+            rep->initial_violation);
     print_blocks(f, s->g, s->gv, p->label, "initial");
   }
   // the main solve's options and Hessian
@@ -430,8 +429,7 @@ int go_solve_run(const go_solve_plan* p, go_solve_report* rep, char* err, int er
   s.p = p;
   s.g = p->gait;
   s.nlp = go_gait_nlp(s.g);
-  int ne;
-  go_nlp_sizes(s.nlp, &s.n, &s.mm, &ne);
+  go_nlp_sizes(s.nlp, &s.n, &s.mm, &s.ne);
   s.z = (double*)malloc(sizeof(double) * (size_t)s.n);
   s.zb = (double*)malloc(sizeof(double) * (size_t)s.n);
   s.zs = (double*)malloc(sizeof(double) * (size_t)s.n);

@@ -1,0 +1,112 @@
+#!/usr/bin/python3
+"""Issue 20's diagnostic figures of a main job's results (docs/BENCHMARKS.md, "Physiology").
+
+usage: scripts/physiology_figures.py [RESULTS]
+
+RESULTS (default results) is the folder `gaitsim run` writes. Prints:
+  - for RESULTS/track: the mean and RMS difference, model minus measured, of the frontal-plane
+    and trunk coordinates (states.sto against the trial's coordinates.mot, at the solution's
+    nodes; deg, or m for pelvis_tz), and the two means: the hip-adduction bias behind the wide
+    stance;
+  - for each RESULTS/sweep/predict_*: the stride-mean metabolic power by muscle group
+    (metabolics.sto, trapezoid over the nodes; W/kg, and J/(kg m) at the prediction's speed),
+    and the mean lumbar_extension (deg).
+Muscle groups by name: trunk (ercspn, intobl, extobl), vasti, soleus, gastrocnemii, rectus
+femoris, hamstrings, gluteals, iliopsoas, adductors, tibialis anterior, other. Exit 1 with one
+line naming the file when an input is missing.
+"""
+import glob
+import os
+import re
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from gs_scriptlib import PrepError, read_json, read_storage  # noqa: E402
+
+COORDINATES = ["pelvis_tz", "pelvis_rx", "hip_adduction", "hip_adduction_l", "knee_adduction",
+               "subtalar_angle", "subtalar_angle_l", "lumbar_extension", "lumbar_bending"]
+GROUPS = [("trunk", "ercspn|intobl|extobl"), ("vasti", "vas"), ("soleus", "soleus"),
+          ("gastrocnemii", "gas"), ("rectus femoris", "rect_fem|recfem"),
+          ("hamstrings", "bf|semi"), ("gluteals", "glmax|glmed|glmin|glut"),
+          ("iliopsoas", "psoas|iliacus"), ("adductors", "add|grac|pect"),
+          ("tibialis anterior", "tibant|tib_ant"), ("other", "")]
+
+
+def columns(path):
+    _, labels, rows = read_storage(path)
+    return {lab: [r[i] for r in rows] for i, lab in enumerate(labels)}
+
+
+def interp(t, ts, ys):
+    """Linear interpolation of (ts, ys) at t (ts increasing)."""
+    for k in range(1, len(ts)):
+        if t <= ts[k]:
+            w = (t - ts[k - 1]) / (ts[k] - ts[k - 1])
+            return ys[k - 1] + w * (ys[k] - ys[k - 1])
+    return ys[-1]
+
+
+def mean_over_time(t, y):
+    """Trapezoid mean of y over t."""
+    area = sum(0.5 * (y[k] + y[k - 1]) * (t[k] - t[k - 1]) for k in range(1, len(t)))
+    return area / (t[-1] - t[0])
+
+
+def tracking(track):
+    s = read_json(os.path.join(track, "summary.json"))
+    trial = s.get("trial")
+    if not trial:
+        raise PrepError(os.path.join(track, "summary.json"), "no trial")
+    model = columns(os.path.join(track, "states.sto"))
+    meas = columns(os.path.join(trial, "coordinates.mot"))
+    print(f"{track}: at its {len(model['time'])} nodes, model minus measured (mean, RMS) and the "
+          "model's and the measured mean")
+    for c in COORDINATES:
+        if c not in model or c not in meas:
+            continue
+        m = [interp(t, meas["time"], meas[c]) for t in model["time"]]
+        d = [y - x for y, x in zip(model[c], m)]
+        rms = (sum(x * x for x in d) / len(d)) ** 0.5
+        print(f"  {c:18s} {sum(d) / len(d):+8.3f} {rms:8.3f}  {sum(model[c]) / len(d):+8.2f} "
+              f"{sum(m) / len(m):+8.2f}")
+
+
+def prediction(folder):
+    s = read_json(os.path.join(folder, "summary.json"))
+    mass = s["body_weight_n"] / 9.81 if s.get("body_weight_n") else None
+    speed = s.get("speed_target_mps")
+    if not mass or not speed:
+        raise PrepError(os.path.join(folder, "summary.json"), "no body_weight_n or speed")
+    met = columns(os.path.join(folder, "metabolics.sto"))
+    power = {name: 0.0 for name, _ in GROUPS}
+    for muscle, values in met.items():
+        if muscle in ("time", "total"):
+            continue
+        group = next(name for name, pat in GROUPS if re.search(pat, muscle))
+        power[group] += mean_over_time(met["time"], values) / mass
+    total = mean_over_time(met["time"], met["total"]) / mass
+    lumbar = columns(os.path.join(folder, "states.sto")).get("lumbar_extension")
+    print(f"{folder}: {speed} m/s, muscles {total:.2f} W/kg ({total / speed:.2f} J/(kg m))"
+          + (f", lumbar_extension mean {sum(lumbar) / len(lumbar):+.1f} deg" if lumbar else ""))
+    for name, _ in GROUPS:
+        print(f"  {name:18s} {power[name]:6.3f} W/kg  {power[name] / speed:6.3f} J/(kg m)  "
+              f"{100 * power[name] / total:5.1f} %")
+
+
+def main(argv):
+    results = argv[1] if len(argv) > 1 else "results"
+    if len(argv) > 2 or results in ("-h", "--help"):
+        print(__doc__.split("\n\n")[1], file=sys.stderr)
+        return 2
+    try:
+        tracking(os.path.join(results, "track"))
+        for folder in sorted(glob.glob(os.path.join(results, "sweep", "predict_*"))):
+            prediction(folder)
+    except PrepError as e:
+        print(f"physiology_figures: {e}", file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))

@@ -1,0 +1,45 @@
+#!/usr/bin/env bash
+# scripts/physiology_figures.py on a synthetic results folder: a tracking solution whose
+# hip_adduction is the trial's minus 5 deg at every node (mean -5.000, RMS 5.000; the model's
+# mean +1.00 against the measured +6.00 over the nodes), and a prediction at 2.0 m/s of a 1000 N
+# (101.94 kg) body whose erector spinae spend 300 W and vasti 100 W throughout (trunk 2.943
+# W/kg, 1.472 J/(kg m), 75 % of 3.924 W/kg; vasti 0.981 W/kg, 0.490 J/(kg m)); a missing
+# states.sto exits 1 with one line naming it.
+# usage: physiology_figures.sh GAITSIM SOURCE_DIR
+set -u
+src=$2
+source "$(dirname "$0")/../cli_common.bash"
+
+/usr/bin/python3 - <<'PY'
+import json, os
+def sto(path, labels, rows):
+    with open(path, "w") as f:
+        f.write("x\nendheader\n" + "\t".join(labels) + "\n")
+        f.writelines("\t".join(str(v) for v in r) + "\n" for r in rows)
+os.makedirs("trial"); os.makedirs("results/track"); os.makedirs("results/sweep/predict_2")
+sto("trial/coordinates.mot", ["time", "hip_adduction"], [[0.1 * k, 1.0 + k] for k in range(11)])
+sto("results/track/states.sto", ["time", "hip_adduction"],
+    [[0.2 * k, -4.0 + 2 * k] for k in range(6)])
+json.dump({"trial": "trial"}, open("results/track/summary.json", "w"))
+sto("results/sweep/predict_2/metabolics.sto", ["time", "ercspn_r", "vasint", "total"],
+    [[0.25 * k, 300.0, 100.0, 400.0] for k in range(5)])
+sto("results/sweep/predict_2/states.sto", ["time", "lumbar_extension"], [[0, -15.0], [1, -17.0]])
+json.dump({"body_weight_n": 1000.0, "speed_target_mps": 2.0},
+          open("results/sweep/predict_2/summary.json", "w"))
+PY
+out=$(/usr/bin/python3 "$src/scripts/physiology_figures.py" results)
+status=$?
+check "exit 0 (got $status)" test "$status" -eq 0
+check "hip_adduction bias -5" grep -qE "^  hip_adduction +-5\.000 +5\.000 +\+1\.00 +\+6\.00$" <<<"$out"
+line="results/sweep/predict_2: 2.0 m/s, muscles 3.92 W/kg (1.96 J/(kg m)), lumbar_extension"
+check "muscles 3.92 W/kg, lumbar -16.0" grep -qF "$line mean -16.0 deg" <<<"$out"
+check "trunk 75 %" grep -qE "^  trunk +2\.943 W/kg +1\.472 J/\(kg m\) +75\.0 %$" <<<"$out"
+check "vasti 25 %" grep -qE "^  vasti +0\.981 W/kg +0\.490 J/\(kg m\) +25\.0 %$" <<<"$out"
+
+rm results/track/states.sto
+err=$(/usr/bin/python3 "$src/scripts/physiology_figures.py" results 2>&1 >/dev/null)
+status=$?
+check "missing states.sto: exit 1 (got $status)" test "$status" -eq 1
+check "missing states.sto: one line naming it" \
+  test "$err" = "physiology_figures: results/track/states.sto: file not found"
+finish

@@ -27,9 +27,10 @@ static const char* kRunUsage =
     "  1. DIR/track: tracking solve on N nodes (default " GO_STR(GO_NODES_MAIN_JOB)
     "; more nodes are solved on " GO_STR(GO_NODES_MAIN_JOB) " first and\n"
     "     continued): up to " GO_STR(GO_MAX_ITER_MAIN_TRACK) " L-BFGS iterations; if they stop "
-    "short, up to " GO_STR(GO_REFINE_ITER) " Newton\n"
-    "     iterations with the exact Hessian (gaitsim track --refine); polished to a dynamically\n"
-    "     consistent point;\n"
+    "short, " GO_STR(GO_REFINE_GN_ITER) " Gauss-Newton\n"
+    "     iterations, then up to " GO_STR(GO_REFINE_ITER) " Newton iterations with the exact "
+    "Hessian until the objective\n"
+    "     settles (gaitsim track --refine); polished to a dynamically consistent point;\n"
     "  2. DIR/sweep/predict_V: predictive solves at the speeds of LIST (default 0.8,2.0: 0.8 and\n"
     "     2.0 m/s, each started from the tracking solution as in the paper, in two\n"
     "     processes; a longer LIST is solved by continuation, gaitsim sweep), DIR/sweep/sweep.md;\n"

@@ -46,7 +46,8 @@ static const char* kTrackUsage =
     "                      kept), else its states.sto and controls.sto interpolated (default:\n"
     "                      the trial)\n"
     "  --threads N         worker threads (default " GO_STR(GO_THREADS) ")\n"
-    "  --max-iter N        Ipopt iteration limit (default " GO_STR(GO_MAX_ITER) ")\n"
+    "  --max-iter N        Ipopt iteration limit of the main (L-BFGS) solve (default "
+    GO_STR(GO_MAX_ITER_TRACK) ")\n"
     "  --max-time S        wall-clock limit, s (default none)\n"
     "  --activation A      initial activations and excitations (default " GO_STR(GO_ACTIVATION)
     ")\n"
@@ -74,6 +75,9 @@ static const char* kTrackUsage =
     "  --no-polish         no feasibility polish (by default a solve that stops short is\n"
     "                      followed by a Gauss-Newton projection of its best iterate onto the\n"
     "                      dynamics: the nearest dynamically consistent point)\n"
+;
+// (in two parts: C11 compilers need not take string literals over 4095 characters)
+static const char* kTrackUsageSolver =
     "  --fallback-rise F   stop when the objective rises by more than the fraction F above the\n"
     "                      lowest one reached at a violation <= " GO_STR(GO_FALLBACK_VIOL)
     ", and restart from the\n"
@@ -84,7 +88,20 @@ static const char* kTrackUsage =
     "                      iterations with the exact Hessian (structured finite differences)\n"
     "                      from its best iterate (default " GO_STR(GO_REFINE_ITER) ", at most "
     GO_STR(GO_REFINE_WALL_S) " s; 0: none;\n"
-    "                      summary.json refine)\n"
+    "                      summary.json refine). They stop at Ipopt's tests or once the\n"
+    "                      objective has settled: " GO_STR(GO_SETTLE_ITER) " of the last "
+    "2 x " GO_STR(GO_SETTLE_ITER) " iterations at a violation <= " GO_STR(GO_SETTLE_VIOL) ",\n"
+    "                      their objectives within " GO_STR(GO_SETTLE_REL) " relative per "
+    "iteration (status\n"
+    "                      \"objective settled\")\n"
+    "  --refine-gn N       Gauss-Newton iterations (the goals' Hessian, without the constraints'\n"
+    "                      curvature) that start the refinement; the Newton iterations start\n"
+    "                      where they stop (default "
+    GO_STR(GO_REFINE_GN_ITER) ";\n"
+    "                      0: none; summary.json refine.gauss_newton)\n"
+    "  --refine-time S     the refinement's wall-clock limit in seconds (default "
+    GO_STR(GO_REFINE_WALL_S) ";\n"
+    "                      --max-time, when given, caps it too)\n"
     "  --ipopt KEY=VALUE   extra Ipopt option (repeatable)\n";
 
 typedef struct {
@@ -142,7 +159,7 @@ static void defaults(gsTrackOptions* o) {
   o->threads = GO_THREADS;
   o->activation = GO_ACTIVATION;
   go_solve_plan_default(&o->plan);
-  o->plan.max_iter = GO_MAX_ITER;
+  o->plan.max_iter = GO_MAX_ITER_TRACK;
   o->plan.progress = stderr;
   o->w_pelvis_rot = GO_TRACK_W_PELVIS_ROT;
   o->w_pelvis_trans = GO_TRACK_W_PELVIS_TRANS;
@@ -170,6 +187,8 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
       {"guess-method", required_argument, NULL, 'G'},
       {"fallback-rise", required_argument, NULL, 'R'},
       {"refine", required_argument, NULL, 'r'},
+      {"refine-time", required_argument, NULL, 'W'},
+      {"refine-gn", required_argument, NULL, 'g'},
       {"help", no_argument, NULL, 'h'},           {NULL, 0, NULL, 0}};
   static const char* const hessians[] = {"lbfgs", "pqn", "exact", "gauss-newton", NULL};
   static const go_hessian_kind kinds[] = {GO_HESSIAN_LBFGS, GO_HESSIAN_PQN, GO_HESSIAN_EXACT,
@@ -180,7 +199,7 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
   opterr = 0;
   int c, bad = 0, k;
   while (!bad &&
-         (c = getopt_long(argc, argv, ":o:m:n:t:i:T:a:p:H:w:I:G:R:r:Ph", options, NULL)) != -1) {
+         (c = getopt_long(argc, argv, ":o:m:n:t:i:T:a:p:H:w:I:G:R:r:W:g:Ph", options, NULL)) != -1) {
     switch (c) {
       case 'o': o->out = optarg; break;
       case 'm': o->model = optarg; break;
@@ -198,6 +217,13 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
         break;
       case 'r':
         bad = gs_opt_int("--refine", optarg, 0, GS_OPT_NO_MAX, &o->plan.refine_iter);
+        break;
+      case 'g':
+        bad = gs_opt_int("--refine-gn", optarg, 0, GS_OPT_NO_MAX, &o->plan.refine_gn_iter);
+        break;
+      case 'W':
+        bad = gs_opt_real("--refine-time", optarg, 0, HUGE_VAL, GS_OPT_LO_OPEN,
+                          &o->plan.refine_wall_s);
         break;
       case 'a': bad = gs_opt_real("--activation", optarg, 0.001, 1, 0, &o->activation); break;
       case 'p':
@@ -217,7 +243,10 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
         o->guess_static = !bad && k == 1;
         break;
       case 'P': o->plan.polish = 0; break;
-      case 'h': fputs(kTrackUsage, stdout); return -1;
+      case 'h':
+        fputs(kTrackUsage, stdout);
+        fputs(kTrackUsageSolver, stdout);
+        return -1;
       default: return gs_opt_getopt_error("track", c, argv);
     }
   }
@@ -896,6 +925,7 @@ int gs_cmd_predict(int argc, char** argv) {
   o.predict = 1;
   o.plan.label = "predict";
   o.plan.refine_iter = 0;  // the exact Hessian leaves out the cost of transport's curvature
+  o.plan.max_iter = GO_MAX_ITER;
   o.nodes = GO_NODES_PREDICT;
   o.w_effort = GO_PREDICT_W_EFFORT;
   o.w_accel = GO_PREDICT_W_ACCEL;
@@ -1127,6 +1157,14 @@ static int solve(gsTrackOptions o) {
     cJSON_AddNumberToObject(fj, "wall_s", rep.refine.wall_s);
     cJSON_AddNumberToObject(fj, "objective", rep.refine.objective);
     cJSON_AddBoolToObject(fj, "used", rep.refined);
+    if (rep.refine_gn_run) {  // its first phase; iterations and wall_s above include it
+      cJSON* gj = cJSON_AddObjectToObject(fj, "gauss_newton");
+      cJSON_AddStringToObject(gj, "status", go_solve_status_str(rep.refine_gn.status));
+      cJSON_AddNumberToObject(gj, "iterations", rep.refine_gn.iterations);
+      cJSON_AddNumberToObject(gj, "wall_s", rep.refine_gn.wall_s);  // its projection included
+      cJSON_AddNumberToObject(gj, "best_objective", rep.refine_gn.best_objective);
+      cJSON_AddNumberToObject(gj, "best_violation", rep.refine_gn.best_viol);
+    }
   }
   // Ipopt's own measures at its last iteration (scaled problem; before the polish)
   cJSON* lj = cJSON_AddObjectToObject(summary, "ipopt_last_iteration");

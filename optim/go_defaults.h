@@ -19,11 +19,18 @@
 // worker threads of one solve (-)
 #define GO_THREADS 2
 // Ipopt iteration limits (-)
-#define GO_MAX_ITER 1000           // track and predict (--max-iter)
+#define GO_MAX_ITER 1000           // predict (--max-iter)
+#define GO_MAX_ITER_TRACK 300      // track's L-BFGS solve, before the refinement (--max-iter):
+                                   // at N = 80 its best iterate after 300 is where the
+                                   // refinement's Gauss-Newton phase does best
+                                   // (docs/BENCHMARKS.md, "Gauss-Newton before Newton")
 #define GO_MAX_ITER_SWEEP 1500     // each prediction of sweep and of run's main job: an
                                    // iteration budget, not a time limit, so results do not
                                    // depend on the load of the machine
-#define GO_MAX_ITER_MAIN_TRACK 600     // run's tracking solve on GO_NODES_MAIN_JOB nodes
+#define GO_MAX_ITER_MAIN_TRACK 200     // run's tracking solve on GO_NODES_MAIN_JOB nodes, before
+                                       // the refinement (Gauss-Newton, then Newton): 200 L-BFGS
+                                       // iterations then settled at J 2.6107 where 600 reached
+                                       // the acceptable level at 2.6122, in less time
 #define GO_MAX_ITER_MAIN_CONTINUED 1000  // run's tracking solve continued on more nodes
 // initial activations and excitations of a guess from the trial or a solution's states (-)
 #define GO_ACTIVATION 0.05
@@ -41,6 +48,21 @@
 // at N = 80 one exact-Hessian iteration costs about 4 times the N = 20 one
 #define GO_REFINE_ITER 150
 #define GO_REFINE_WALL_S 600
+// the refinement's first phase: GO_REFINE_GN_ITER Gauss-Newton iterations (-); Newton starts
+// where they stop. From the L-BFGS best iterate at N = 80 they lowered J from 2.872 to 2.645 (at
+// a violation of 0.1, which Newton's first 11 iterations brought to 4e-4 at J 2.643), where 124
+// Newton iterations alone reached 2.726 (docs/BENCHMARKS.md, "Gauss-Newton before Newton")
+#define GO_REFINE_GN_ITER 60
+// the refinement's settled rule (go_ipopt_opts.settle_iter): GO_SETTLE_ITER iterations (-) at a
+// scaled violation <= GO_SETTLE_VIOL (the level the polish takes in a few iterations) among the
+// last 2 GO_SETTLE_ITER, whose objectives span <= GO_SETTLE_REL (-) relative per iteration
+// between the first and the last of them: Ipopt's acceptable level (each of 15 consecutive
+// iterations changes J by <= 1e-4 relative, at a violation <= 1e-4) in the mean, without the
+// need for consecutive iterations that the exact Hessian's violation spikes (1e-3 - 1e-1 every
+// few iterations) reset
+#define GO_SETTLE_ITER 15
+#define GO_SETTLE_REL 1e-4
+#define GO_SETTLE_VIOL 1e-3
 // feasibility polish (go_solve.h): Gauss-Newton iterations at most (-), and its wall-clock cap
 // after a stop signal (s)
 #define GO_POLISH_ITER 200

@@ -227,7 +227,11 @@ typedef struct {
   int last_alg_mod;                          // 1: restoration phase
   double low_obj;   // lowest physical objective of iterations with inf_pr <= fallback_viol
   int have_low_obj;
-  int stop_reason;  // 0 none, 1 interrupted, 2 wall time, 3 fell back (fallback_rise)
+  int stop_reason;  // 0 none, 1 interrupted, 2 wall time, 3 fell back (fallback_rise),
+                    // 4 settled (settle_iter)
+  int settle_it[2 * GO_IPOPT_MAX_SETTLE];    // iterations near feasibility (ring, newest last)
+  double settle_J[2 * GO_IPOPT_MAX_SETTLE];  // their physical objectives
+  int settle_n;                              // entries used
   struct timespec t0;
 } solve_state;
 
@@ -343,6 +347,34 @@ static void score(solve_state* s, const double* x, int iter) {
   }
 }
 
+// the settled rule (go_ipopt_opts.settle_iter): note iteration iter of physical objective J
+// when inf_pr <= settle_viol, and say whether settle_iter such iterations lie among the last
+// 2 settle_iter with objectives spanning at most settle_rel of the lowest per iteration between
+// the first and the last of them (Ipopt's acceptable_obj_change_tol bounds each iteration's
+// change; this bounds their mean)
+static int settled(solve_state* s, int iter, double J, double inf_pr) {
+  const go_ipopt_opts* o = s->opts;
+  int k = o->settle_iter < GO_IPOPT_MAX_SETTLE ? o->settle_iter : GO_IPOPT_MAX_SETTLE;
+  if (k <= 0 || !isfinite(J) || !(inf_pr <= o->settle_viol)) return 0;
+  if (s->settle_n == 2 * GO_IPOPT_MAX_SETTLE) {  // drop the oldest
+    memmove(s->settle_it, s->settle_it + 1, sizeof(int) * (size_t)(s->settle_n - 1));
+    memmove(s->settle_J, s->settle_J + 1, sizeof(double) * (size_t)(s->settle_n - 1));
+    s->settle_n--;
+  }
+  s->settle_it[s->settle_n] = iter;
+  s->settle_J[s->settle_n] = J;
+  s->settle_n++;
+  if (s->settle_n < k) return 0;
+  int first = s->settle_n - k;  // the newest k entries
+  if (iter - s->settle_it[first] >= 2 * k) return 0;
+  double lo = J, hi = J;
+  for (int i = first; i < s->settle_n; i++) {
+    lo = fmin(lo, s->settle_J[i]);
+    hi = fmax(hi, s->settle_J[i]);
+  }
+  return hi - lo <= o->settle_rel * fabs(lo) * (double)(iter - s->settle_it[first]);
+}
+
 static Bool cb_iter(Index alg_mod, Index iter, Number obj, Number inf_pr, Number inf_du, Number mu,
                     Number d_norm, Number reg, Number alpha_du, Number alpha_pr, Index ls,
                     UserDataPtr u) {
@@ -369,6 +401,14 @@ static Bool cb_iter(Index alg_mod, Index iter, Number obj, Number inf_pr, Number
   }
   if (s->opts->max_wall_s > 0 && t >= s->opts->max_wall_s) {
     s->stop_reason = 2;
+    return FALSE;
+  }
+  if (!alg_mod && settled(s, (int)iter, go_nlp_objective_phys(s->nlp, obj), inf_pr)) {
+    if (s->opts->progress)
+      fprintf(s->opts->progress, "settled: %d iterations at inf_pr <= %.0e within the last %d, "
+              "objectives within %.0e relative; stopping\n", s->opts->settle_iter,
+              s->opts->settle_viol, 2 * s->opts->settle_iter, s->opts->settle_rel);
+    s->stop_reason = 4;
     return FALSE;
   }
   if (s->opts->fallback_rise > 0 && !alg_mod && isfinite(obj)) {
@@ -400,7 +440,8 @@ static go_solve_status map_status(int st, int stop_reason) {
     case User_Requested_Stop:
       return stop_reason == 1 ? GO_SOLVE_INTERRUPTED
              : stop_reason == 2 ? GO_SOLVE_MAX_WALL_TIME
-             : stop_reason == 3 ? GO_SOLVE_FELL_BACK : GO_SOLVE_INTERNAL_ERROR;
+             : stop_reason == 3 ? GO_SOLVE_FELL_BACK
+             : stop_reason == 4 ? GO_SOLVE_SETTLED : GO_SOLVE_INTERNAL_ERROR;
     case Maximum_Iterations_Exceeded: return GO_SOLVE_MAX_ITER;
     case Maximum_CpuTime_Exceeded: return GO_SOLVE_MAX_CPU_TIME;
     case Restoration_Failed: return GO_SOLVE_RESTORATION_FAILED;
@@ -431,6 +472,7 @@ const char* go_solve_status_str(go_solve_status st) {
     case GO_SOLVE_BAD_PROBLEM: return "invalid problem definition";
     case GO_SOLVE_BAD_OPTION: return "invalid option";
     case GO_SOLVE_FELL_BACK: return "fell back from the solution it had reached";
+    case GO_SOLVE_SETTLED: return "objective settled";
     case GO_SOLVE_INTERNAL_ERROR: return "internal error";
   }
   return "unknown status";

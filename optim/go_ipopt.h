@@ -27,6 +27,7 @@
 #include "optim/go_collocation.h"
 
 #define GO_IPOPT_MAX_OPTIONS 64
+#define GO_IPOPT_MAX_SETTLE 64  // settle_iter at most
 
 typedef struct {
   char key[64];    // Ipopt option name
@@ -55,6 +56,14 @@ typedef struct {
   struct go_hess* hess;   // non-NULL: Ipopt's exact-Hessian mode with this partitioned
                           // quasi-Newton Hessian (go_hessian.h; takes precedence over
                           // gauss_newton); not owned
+  int settle_iter;        // > 0: stop (GO_SOLVE_SETTLED) once settle_iter iterations outside the
+                          // restoration phase with inf_pr <= settle_viol have come among the
+                          // last 2 settle_iter, and their objectives span at most settle_rel of
+                          // the lowest per iteration from the first of them to the last (Ipopt's
+                          // acceptable test bounds each change, over consecutive iterations, which
+                          // one violation spike resets); 0: off; at most GO_IPOPT_MAX_SETTLE
+  double settle_rel;      // the settled rule's relative objective change per iteration (-)
+  double settle_viol;     // violation (scaled, max norm, Ipopt's inf_pr) of the settled rule
   int n_kv;               // extra Ipopt options, applied after all of the above, in order
   go_ipopt_kv kv[GO_IPOPT_MAX_OPTIONS];
 } go_ipopt_opts;
@@ -77,6 +86,8 @@ typedef enum {
   GO_SOLVE_BAD_OPTION,         // invalid option
   GO_SOLVE_FELL_BACK,          // stopped by fallback_rise: the objective rose far above the
                                // lowest one reached near feasibility
+  GO_SOLVE_SETTLED,            // stopped by settle_iter: the objective settled near feasibility
+                               // (the best iterate is the point to use)
   GO_SOLVE_INTERNAL_ERROR,     // exceptions, memory, internal errors, user stop of unknown cause
 } go_solve_status;
 

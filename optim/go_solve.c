@@ -52,6 +52,10 @@ void go_solve_plan_default(go_solve_plan* p) {
   p->max_restarts = GO_MAX_RESTARTS;
   p->refine_iter = GO_REFINE_ITER;
   p->refine_wall_s = GO_REFINE_WALL_S;
+  p->refine_gn_iter = GO_REFINE_GN_ITER;
+  p->settle_iter = GO_SETTLE_ITER;
+  p->settle_rel = GO_SETTLE_REL;
+  p->settle_viol = GO_SETTLE_VIOL;
   p->polish = 1;
   p->polish_iter = GO_POLISH_ITER;
   p->stop_polish_wall_s = GO_STOP_POLISH_S;
@@ -174,7 +178,8 @@ static int set_polish(go_ipopt_opts* po, char* err, int errsz) {
 
 // Ipopt's optimal or acceptable level: the project's stopping rule was met
 static int solve_converged(const go_solve_result* r) {
-  return r->status == GO_SOLVE_SUCCESS || r->status == GO_SOLVE_ACCEPTABLE;
+  return r->status == GO_SOLVE_SUCCESS || r->status == GO_SOLVE_ACCEPTABLE ||
+         r->status == GO_SOLVE_SETTLED;
 }
 
 // a solve that continued an earlier one: iterations, the best iterate's index, times add up
@@ -260,30 +265,77 @@ static int refine(run_state* s, const go_ipopt_opts* opts, go_solve_report* rep,
     snprintf(err, (size_t)errsz, "refine: %s", why);
     return -1;
   }
-  go_ipopt_opts ro = *opts;
-  ro.hess = s->hess;
-  ro.max_iter = p->refine_iter;
-  // at most refine_wall_s, or what is left of max_wall_s
-  ro.max_wall_s = p->max_wall_s > 0 ? fmin(p->max_wall_s - res->wall_s, p->refine_wall_s)
+  // both phases share at most refine_wall_s, or what is left of max_wall_s
+  double budget = p->max_wall_s > 0 ? fmin(p->max_wall_s - res->wall_s, p->refine_wall_s)
                                     : p->refine_wall_s;
+  go_ipopt_opts ro = *opts;
+  ro.max_wall_s = budget;
   if (set_start_near_solution(&ro, why, sizeof(why)) != 0) {
     snprintf(err, (size_t)errsz, "refine: %s", why);
     return -1;
   }
-  if (p->progress)
-    fprintf(p->progress, "%s: %s after %d iterations; exact-Hessian refinement from the best "
-            "iterate (iteration %d, objective %.6g, violation %.3g), up to %d iterations\n",
-            p->label, go_solve_status_str(res->status), res->iterations, res->best_iter,
-            res->best_objective, res->best_viol, p->refine_iter);
   // z (Ipopt's point of a solve that stopped short, not used: its output is zb) takes the
   // refinement's point, zs its best iterate
   memcpy(s->z, s->zb, sizeof(double) * (size_t)s->n);
+  go_ipopt_mult* mult = s->lam ? &s->mult : NULL;
+  // phase 1, Gauss-Newton: the goals' exact Hessian without the constraints' curvature, positive
+  // semi-definite, so Ipopt takes its steps without the inertia correction that shrinks the
+  // exact Hessian's (docs/BENCHMARKS.md, "Gauss-Newton before Newton")
+  go_solve_result* gres = &rep->refine_gn;
+  rep->refine_gn_run = p->refine_gn_iter > 0;
+  if (rep->refine_gn_run) {
+    go_ipopt_opts go = ro;
+    go.hess = NULL;
+    go.gauss_newton = 1;
+    go.max_iter = p->refine_gn_iter;
+    if (p->progress)
+      fprintf(p->progress, "%s: %s after %d iterations; Gauss-Newton refinement from the best "
+              "iterate (iteration %d, objective %.6g, violation %.3g), %d iterations\n",
+              p->label, go_solve_status_str(res->status), res->iterations, res->best_iter,
+              res->best_objective, res->best_viol, p->refine_gn_iter);
+    if (go_ipopt_solve(s->nlp, &go, s->z, s->zs, mult, gres, why, sizeof(why)) != 0) {
+      snprintf(err, (size_t)errsz, "refine: %s", why);
+      return -1;
+    }
+    if (p->progress)
+      fprintf(p->progress, "%s: Gauss-Newton: %s after %d iterations, %.1f s, objective %.6g at "
+              "violation %.3g\n", p->label, go_solve_status_str(gres->status),
+              gres->iterations, gres->wall_s, gres->objective, gres->max_viol);
+    // Newton starts where Gauss-Newton stopped: its iterates stay 1e-2 - 1e-1 off the dynamics,
+    // which Newton's first iterations take back to 1e-4 at about the same objective (a
+    // projection onto the dynamics does not: the nearest consistent point lets the pelvis
+    // drift); unless Gauss-Newton failed, when Newton starts from the L-BFGS best iterate
+    int gn_usable = isfinite(gres->objective) && isfinite(gres->max_viol) &&
+                    !gres->last_restoration &&
+                    (gres->status == GO_SOLVE_MAX_ITER || solve_converged(gres));
+    if (!gn_usable) memcpy(s->z, s->zb, sizeof(double) * (size_t)s->n);
+    ro.max_wall_s = budget - gres->wall_s;
+    if (gres->status == GO_SOLVE_INTERRUPTED || ro.max_wall_s <= 0) {
+      // nothing left for Newton: the Gauss-Newton phase stands for the refinement, its best
+      // iterate (by the usual ranking) kept when it beats the L-BFGS one
+      rep->refine = *gres;
+      rep->refined = gres->best_iter >= 0 &&
+                     go_ipopt_point_better(gres->best_objective, gres->best_viol,
+                                           res->best_objective, res->best_viol,
+                                           ro.best_viol_tol);
+      goto kept;
+    }
+  }
+  // phase 2, Newton with the exact Hessian, stopped by Ipopt's tests or the settled rule
+  ro.hess = s->hess;
+  ro.max_iter = p->refine_iter;
+  ro.settle_iter = p->settle_iter;
+  ro.settle_rel = p->settle_rel;
+  ro.settle_viol = p->settle_viol;
+  if (p->progress)
+    fprintf(p->progress, "%s: exact-Hessian refinement, up to %d iterations\n", p->label,
+            p->refine_iter);
   go_solve_result* rres = &rep->refine;
-  if (go_ipopt_solve(s->nlp, &ro, s->z, s->zs, s->lam ? &s->mult : NULL, rres, why,
-                     sizeof(why)) != 0) {
+  if (go_ipopt_solve(s->nlp, &ro, s->z, s->zs, mult, rres, why, sizeof(why)) != 0) {
     snprintf(err, (size_t)errsz, "refine: %s", why);
     return -1;
   }
+  if (rep->refine_gn_run) continue_result(rres, gres);
   // used: converged, or stopped short at a best iterate that beats the L-BFGS one by the glue's
   // ranking (among points the polish can take, the lower objective)
   rep->refined = solve_converged(rres) ||
@@ -297,9 +349,10 @@ static int refine(run_state* s, const go_ipopt_opts* opts, go_solve_report* rep,
             solve_converged(rres) ? ""
             : rep->refined ? "; its best iterate beats the L-BFGS one and is kept"
                            : "; the L-BFGS best iterate stays");
+kept:
   if (rep->refined) {
     memcpy(s->zb, s->zs, sizeof(double) * (size_t)s->n);
-    go_solve_result merged = *rres;
+    go_solve_result merged = rep->refine;
     continue_result(&merged, res);
     *res = merged;
   }
@@ -396,7 +449,10 @@ static int run_stages(run_state* s, go_solve_report* rep, char* err, int errsz) 
   if (s->lam && f) print_largest_multipliers(f, s->g, s->lam, p->label);
   // the point chosen: Ipopt's when it converged, else the best iterate; then its polish
   rep->converged = solve_converged(&rep->result);
-  double* zout = rep->converged || rep->result.best_iter < 0 ? s->z : s->zb;
+  // (a settled solve stopped where it was: its best iterate is the point)
+  double* zout =
+      (rep->converged && rep->result.status != GO_SOLVE_SETTLED) || rep->result.best_iter < 0
+          ? s->z : s->zb;
   if (polish(s, &zout, rep, err, errsz) != 0) return -1;
   rep->best_iterate_written = zout == s->zb;
   memcpy(rep->z, zout, sizeof(double) * (size_t)s->n);

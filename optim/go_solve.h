@@ -69,6 +69,11 @@ typedef struct {
                               // most, the size of go_solve_report.restarts)
   int refine_iter;            // refinement's Newton iterations at most (-); 0: no refinement
   double refine_wall_s;       // refinement's wall-clock cap (s), or less when max_wall_s says
+  int refine_gn_iter;         // Gauss-Newton iterations before the refinement's Newton ones (-);
+                              // 0: none
+  int settle_iter;            // the refinement's settled rule (go_ipopt_opts.settle_iter, -)
+  double settle_rel;          // its relative objective span (-)
+  double settle_viol;         // its violation (scaled, max norm, -)
   int polish;                 // 1: feasibility polish of the point chosen
   int polish_iter;            // polish iterations at most (-)
   double stop_polish_wall_s;  // polish's wall-clock cap after a stop signal (s)
@@ -96,7 +101,10 @@ typedef struct {
   int n_restarts;             // restarts done (-)
   go_solve_restart restarts[GO_MAX_RESTARTS];  // in order (n_restarts)
   int refined;                // -1: no refinement run, 0: run and not used, 1: used
-  go_solve_result refine;     // the refinement solve (refined >= 0)
+  go_solve_result refine;     // the refinement (refined >= 0): its Newton solve, iterations
+                              // and times including its Gauss-Newton phase
+  int refine_gn_run;          // 1: the refinement's Gauss-Newton phase ran
+  go_solve_result refine_gn;  // that phase (refine_gn_run)
   int polish_run;             // 1: the polish ran
   int polished;               // 1: its point is the one chosen
   go_solve_result polish;     // the polish solve (polish_run)

@@ -146,6 +146,33 @@ int main(void) {
   EXPECT_EQ_INT(it_ref, r.iterations);
   EXPECT_NEAR(12.0, r.objective, 0.2);
 
+  // settled rule: with 3 iterations at any violation (settle_viol 1e10) whose objectives span
+  // 1 % per iteration at most, the solve stops with its own status before Ipopt's own test (tol 1e-12 so that
+  // it does not come first), at an objective within 1 % of the optimum's; with a violation no
+  // iterate reaches it never fires and the solve is the one without it
+  go_ipopt_opts_default(&o);
+  o.tol = 1e-12;
+  guess(z);
+  EXPECT_EQ_INT(0, solve(nlp, &o, z, zb, NULL, &r, &rc, err));
+  double j_tight = r.objective;
+  int it_tight = r.iterations;
+  o.settle_iter = 3;
+  o.settle_rel = 1e-2;
+  o.settle_viol = 1e10;
+  guess(z);
+  EXPECT_EQ_INT(0, solve(nlp, &o, z, zb, NULL, &r, &rc, err));
+  EXPECT_EQ_INT(GO_SOLVE_SETTLED, r.status);
+  EXPECT_TRUE(r.iterations >= 2 && r.iterations < it_tight);
+  EXPECT_NEAR(j_tight, r.objective, 0.01 * j_tight);
+  printf("settled rule: %s after %d iterations, J %.4f (Ipopt's tol 1e-12: %d, J %.4f)\n",
+         go_solve_status_str(r.status), r.iterations, r.objective, it_tight, j_tight);
+  o.settle_viol = 1e-30;
+  guess(z);
+  EXPECT_EQ_INT(0, solve(nlp, &o, z, zb, NULL, &r, &rc, err));
+  EXPECT_EQ_INT(GO_SOLVE_SUCCESS, r.status);
+  EXPECT_EQ_INT(it_tight, r.iterations);
+  EXPECT_NEAR(j_tight, r.objective, 1e-12);
+
   // ./ipopt.opt in the working directory is not read (it would stop after 1 iteration and print)
   char cwd[4096], dir[] = "/tmp/gs_test_ipoptopt_XXXXXX";
   EXPECT_TRUE(getcwd(cwd, sizeof(cwd)) != NULL);

@@ -6,11 +6,15 @@
 //      <= fallback_viol, and left it), again from the best iterate with the iterations and time
 //      left, a small barrier and the point barely pushed off its bounds; at most max_restarts;
 //   3. refinement: an L-BFGS solve that stopped short (not converged, not interrupted) is
-//      followed by up to refine_iter Newton iterations with the exact Hessian (structured finite
-//      differences, go_hess_create_fd) from its best iterate; their result replaces the L-BFGS
-//      one when Ipopt reaches its optimal or acceptable level, and so does their best iterate
-//      when it beats the L-BFGS one (go_ipopt_point_better); else the L-BFGS best iterate stays;
-//   4. the point chosen: Ipopt's when converged (or no iterate was scored), else the best iterate;
+//      followed, from its best iterate, by refine_gn_iter Gauss-Newton iterations (the goals'
+//      Hessian, positive semi-definite) and, from where they stop, up to refine_iter Newton
+//      iterations with the exact Hessian (structured finite differences, go_hess_create_fd),
+//      stopped by Ipopt's tests or the settled rule (settle_iter, settle_rel, settle_viol:
+//      GO_SOLVE_SETTLED); their result replaces the L-BFGS one when they converge (Ipopt's
+//      optimal or acceptable level, or settled), and so does their best iterate when it beats
+//      the L-BFGS one (go_ipopt_point_better); else the L-BFGS best iterate stays;
+//   4. the point chosen: Ipopt's when it converged by its own tests (or no iterate was scored),
+//      else (stopped short, or settled) the best iterate;
 //   5. feasibility polish: when that point is violated by more than 1e-8, the dynamically
 //      consistent point nearest to it (go_gait_set_proximal, Gauss-Newton Hessian), used when
 //      its violation is lower.

@@ -229,9 +229,9 @@ typedef struct {
   int have_low_obj;
   int stop_reason;  // 0 none, 1 interrupted, 2 wall time, 3 fell back (fallback_rise),
                     // 4 settled (settle_iter)
-  int settle_it[2 * GO_IPOPT_MAX_SETTLE];    // iterations near feasibility (ring, newest last)
-  double settle_J[2 * GO_IPOPT_MAX_SETTLE];  // their physical objectives
-  int settle_n;                              // entries used
+  int settle_it[GO_IPOPT_MAX_SETTLE];    // the latest iterations near feasibility, newest last
+  double settle_J[GO_IPOPT_MAX_SETTLE];  // their physical objectives
+  int settle_n;                          // entries used (at most settle_iter)
   struct timespec t0;
 } solve_state;
 
@@ -356,23 +356,21 @@ static int settled(solve_state* s, int iter, double J, double inf_pr) {
   const go_ipopt_opts* o = s->opts;
   int k = o->settle_iter < GO_IPOPT_MAX_SETTLE ? o->settle_iter : GO_IPOPT_MAX_SETTLE;
   if (k <= 0 || !isfinite(J) || !(inf_pr <= o->settle_viol)) return 0;
-  if (s->settle_n == 2 * GO_IPOPT_MAX_SETTLE) {  // drop the oldest
-    memmove(s->settle_it, s->settle_it + 1, sizeof(int) * (size_t)(s->settle_n - 1));
-    memmove(s->settle_J, s->settle_J + 1, sizeof(double) * (size_t)(s->settle_n - 1));
+  if (s->settle_n == k) {  // keep the newest k: drop the oldest
+    memmove(s->settle_it, s->settle_it + 1, sizeof(int) * (size_t)(k - 1));
+    memmove(s->settle_J, s->settle_J + 1, sizeof(double) * (size_t)(k - 1));
     s->settle_n--;
   }
   s->settle_it[s->settle_n] = iter;
   s->settle_J[s->settle_n] = J;
   s->settle_n++;
-  if (s->settle_n < k) return 0;
-  int first = s->settle_n - k;  // the newest k entries
-  if (iter - s->settle_it[first] >= 2 * k) return 0;
+  if (s->settle_n < k || iter - s->settle_it[0] >= 2 * k) return 0;
   double lo = J, hi = J;
-  for (int i = first; i < s->settle_n; i++) {
+  for (int i = 0; i < k; i++) {
     lo = fmin(lo, s->settle_J[i]);
     hi = fmax(hi, s->settle_J[i]);
   }
-  return hi - lo <= o->settle_rel * fabs(lo) * (double)(iter - s->settle_it[first]);
+  return hi - lo <= o->settle_rel * fabs(lo) * (double)(iter - s->settle_it[0]);
 }
 
 static Bool cb_iter(Index alg_mod, Index iter, Number obj, Number inf_pr, Number inf_du, Number mu,
@@ -406,7 +404,7 @@ static Bool cb_iter(Index alg_mod, Index iter, Number obj, Number inf_pr, Number
   if (!alg_mod && settled(s, (int)iter, go_nlp_objective_phys(s->nlp, obj), inf_pr)) {
     if (s->opts->progress)
       fprintf(s->opts->progress, "settled: %d iterations at inf_pr <= %.0e within the last %d, "
-              "objectives within %.0e relative; stopping\n", s->opts->settle_iter,
+              "objectives within %.0e relative per iteration; stopping\n", s->opts->settle_iter,
               s->opts->settle_viol, 2 * s->opts->settle_iter, s->opts->settle_rel);
     s->stop_reason = 4;
     return FALSE;

@@ -76,7 +76,7 @@ typedef struct {
   int refine_gn_iter;         // Gauss-Newton iterations before the refinement's Newton ones (-);
                               // 0: none
   int settle_iter;            // the refinement's settled rule (go_ipopt_opts.settle_iter, -)
-  double settle_rel;          // its relative objective span (-)
+  double settle_rel;          // its relative objective change per iteration (-)
   double settle_viol;         // its violation (scaled, max norm, -)
   int polish;                 // 1: feasibility polish of the point chosen
   int polish_iter;            // polish iterations at most (-)

@@ -1161,9 +1161,10 @@ static int solve(gsTrackOptions o) {
       cJSON* gj = cJSON_AddObjectToObject(fj, "gauss_newton");
       cJSON_AddStringToObject(gj, "status", go_solve_status_str(rep.refine_gn.status));
       cJSON_AddNumberToObject(gj, "iterations", rep.refine_gn.iterations);
-      cJSON_AddNumberToObject(gj, "wall_s", rep.refine_gn.wall_s);  // its projection included
-      cJSON_AddNumberToObject(gj, "best_objective", rep.refine_gn.best_objective);
-      cJSON_AddNumberToObject(gj, "best_violation", rep.refine_gn.best_viol);
+      cJSON_AddNumberToObject(gj, "wall_s", rep.refine_gn.wall_s);
+      // its last point, where the Newton iterations start
+      cJSON_AddNumberToObject(gj, "objective", rep.refine_gn.objective);
+      cJSON_AddNumberToObject(gj, "violation", rep.refine_gn.max_viol);
     }
   }
   // Ipopt's own measures at its last iteration (scaled problem; before the polish)

@@ -5,9 +5,9 @@
 # 20 s). From that far (violation 125) they do not converge, but the Newton best iterate beats
 # the L-BFGS one by the glue's ranking (the lower violation, both being far from the polishable
 # 1e-3), so it is kept: summary.json refine {status "iteration limit reached", iterations 14
-# (both phases), gauss_newton {iterations 4}, used true}, the progress says so, "iterations"
-# counts all solves (17), and wall_s the whole solve: at least the solves' ipopt_wall_s and the
-# polish's wall time together. --refine 0 runs no refinement (no refine object); --refine with
+# (both phases), gauss_newton {iterations 4, objective and violation of its last point}, used
+# true}, the progress says so, "iterations" counts all solves (17), and wall_s the whole solve:
+# at least the solves' ipopt_wall_s and the polish's wall time together. --refine 0 runs no refinement (no refine object); --refine with
 # a negative count is a usage error (exit 2). --refine-time 0.5 stops a refinement by its wall
 # clock before its 10 Newton iterations (each takes about 2 s).
 # usage: refine.sh GAITSIM SOURCE_DIR
@@ -28,6 +28,8 @@ r = s.get("refine", {})
 gn = r.get("gauss_newton", {})
 ok = (r.get("status") == "iteration limit reached" and r.get("iterations") == 14
       and gn.get("iterations") == 4 and gn.get("wall_s", -1) >= 0
+      and math.isfinite(gn.get("objective", float("nan")))
+      and math.isfinite(gn.get("violation", float("nan")))
       and r.get("used") is True and math.isfinite(r.get("objective", float("nan")))
       and s["iterations"] == 17 and s["status"] == "iteration limit reached"
       # wall_s counts the whole solve, the refinement not kept and the polish included

@@ -36,6 +36,9 @@ typedef struct {
   double* P;          // muscle powers (na)
   double* Pm;         // muscle powers, - perturbation (na)
   double* zp;         // perturbed node variables (nz)
+  double* mus;        // per-muscle scratch of the metabolic gradient (4 na)
+  double* mom;        // actuator moment arms at the node (na x nv, m or m/rad)
+  double* dmom;       // their derivative along qdot (na x nv, m/s or m/(rad s))
 } gait_ctx;
 
 #define GO_GAIT_MAX_MUSCLES 512
@@ -369,21 +372,39 @@ static double sum(const double* x, int n) {
   return s;
 }
 
-// metabolic integrand cot_scale * sum_i P_i and its gradient (dL, added; NULL: none) by central
-// differences that use the structure: a_i, e_i and fT_e move only muscle i's power, so each of
-// the three is perturbed for all muscles at once (2 evaluations each, position stage reused);
-// q_j and qdot_j one at a time (2 nv evaluations)
+// metabolic integrand cot_scale * sum_i P_i and its gradient (dL, added; NULL: none).
+// Muscle i's power depends on its excitation e_i, activation a_i and tendon force fT_i, and on
+// q and qdot only through its actuator's length l_i(q) and velocity v_i = sum_j r_ij(q) qdot_j
+// (r = actuator_moment = dl/dq; nq == nv, go_gait_create), so by the chain rule
+//   dP/dqdot_j = sum_i dP_i/dv_i r_ij
+//   dP/dq_j    = sum_i (dP_i/dl_i r_ij + dP_i/dv_i dv_i/dq_j),
+//   dv_i/dq_j  = sum_k (d2 l_i / dq_j dq_k) qdot_k = d/de r_ij(q + e qdot)   (d2 l_i symmetric).
+// The partials in e, a, fT, l and v are central differences, each perturbed for all muscles at
+// once (2 muscle evaluations each, no kinematics); d r / de is a central difference of the
+// position stage at q +- e qdot (2 evaluations). 14 muscle sweeps and 3 position stages per
+// node, where differencing every q_j and qdot_j took 4 nv full kinematics.
 static double metabolic(const go_gait* g, gait_ctx* c, const double* z, double* dL) {
   const go_gait_layout* L = &g->L;
-  int na = L->na, nz = L->nz;
+  const mjModel* m = g->m;
+  mjData* d = c->d;
+  int na = L->na, nv = L->nv, nz = L->nz;
   double* P = c->P;
-  muscle_powers(g, c->d, z, 1, P);
+  muscle_powers(g, d, z, 1, P);
   double val = g->cot_scale * sum(P, na);
   if (!dL) return val;
   double* zp = c->zp;
   double* Pm = c->Pm;
+  double* len0 = c->mus;            // actuator lengths at z (na)
+  double* vel0 = c->mus + na;       // actuator velocities at z (na)
+  double* dPdl = c->mus + 2 * na;   // dP_i/dl_i (W/m)
+  double* dPdv = c->mus + 3 * na;   // dP_i/dv_i (W s/m)
+  double* r = c->mom;               // actuator moment arms at z (na x nv)
+  double* dr = c->dmom;             // d r / de along qdot (na x nv)
+  mju_copy(len0, d->actuator_length, na);
+  mju_copy(vel0, d->actuator_velocity, na);
+  mju_copy(r, d->actuator_moment, na * nv);
   memcpy(zp, z, sizeof(double) * (size_t)nz);
-  // per-muscle variables, all muscles at once (kinematics of z still in c->d)
+  // per-muscle variables, all muscles at once (kinematics of z still in d)
   const int blocks[3][2] = {{L->x_a, na}, {L->u_e, na}, {L->x_ft, L->ne}};
   for (int b = 0; b < 3; b++) {
     int off = blocks[b][0], cnt = blocks[b][1];
@@ -392,26 +413,62 @@ static double metabolic(const go_gait* g, gait_ctx* c, const double* z, double* 
       hs[i] = 1e-6 * fmax(1.0, fabs(z[off + i]));
       zp[off + i] = z[off + i] + hs[i];
     }
-    muscle_powers(g, c->d, zp, 0, P);
+    muscle_powers(g, d, zp, 0, P);
     for (int i = 0; i < cnt; i++) zp[off + i] = z[off + i] - hs[i];
-    muscle_powers(g, c->d, zp, 0, Pm);
+    muscle_powers(g, d, zp, 0, Pm);
     for (int i = 0; i < cnt; i++) {
       int mi = b == 2 ? L->elastic[i] : i;
       dL[off + i] += g->cot_scale * (P[mi] - Pm[mi]) / (2 * hs[i]);
       zp[off + i] = z[off + i];
     }
   }
-  // coordinates and speeds
-  for (int v = 0; v < 2 * L->nv; v++) {
-    int j = (v < L->nv ? L->x_q : L->x_qd) + v % L->nv;
-    double h = 1e-6 * fmax(1.0, fabs(z[j]));
-    zp[j] = z[j] + h;
-    muscle_powers(g, c->d, zp, 1, P);
-    double sp = sum(P, na);
-    zp[j] = z[j] - h;
-    muscle_powers(g, c->d, zp, 1, Pm);
-    zp[j] = z[j];
-    dL[j] += g->cot_scale * (sp - sum(Pm, na)) / (2 * h);
+  // actuator lengths, then velocities, all muscles at once
+  for (int b = 0; b < 2; b++) {
+    double* x = b == 0 ? d->actuator_length : d->actuator_velocity;
+    const double* x0 = b == 0 ? len0 : vel0;
+    double* dPdx = b == 0 ? dPdl : dPdv;
+    double hs[GO_GAIT_MAX_MUSCLES];
+    for (int i = 0; i < na; i++) {
+      hs[i] = 1e-6 * fmax(1.0, fabs(x0[i]));
+      x[i] = x0[i] + hs[i];
+    }
+    muscle_powers(g, d, z, 0, P);
+    for (int i = 0; i < na; i++) x[i] = x0[i] - hs[i];
+    muscle_powers(g, d, z, 0, Pm);
+    for (int i = 0; i < na; i++) {
+      dPdx[i] = (P[i] - Pm[i]) / (2 * hs[i]);
+      x[i] = x0[i];
+    }
+  }
+  // moment arms along qdot: r(q + e qdot) - r(q - e qdot), a step of 1e-6 in the largest q_j
+  const double* q = z + L->x_q;
+  const double* qd = z + L->x_qd;
+  double qd_max = 0;
+  for (int j = 0; j < nv; j++) qd_max = fmax(qd_max, fabs(qd[j]));
+  memset(dr, 0, sizeof(double) * (size_t)na * nv);
+  if (qd_max > 0) {
+    double eps = 1e-6 / qd_max;
+    for (int s = 0; s < 2; s++) {
+      for (int j = 0; j < nv; j++) d->qpos[j] = q[j] + (s == 0 ? eps : -eps) * qd[j];
+      mj_kinematics(m, d);
+      mj_comPos(m, d);
+      mj_tendon(m, d);
+      mj_transmission(m, d);
+      mju_addToScl(dr, d->actuator_moment, s == 0 ? 1.0 / (2 * eps) : -1.0 / (2 * eps),
+                   na * nv);
+    }
+    mju_copy(d->qpos, q, nv);  // d's position stage is now stale; callers recompute it
+  }
+  double* dq = dL + L->x_q;
+  double* dqd = dL + L->x_qd;
+  for (int i = 0; i < na; i++) {
+    double gl = g->cot_scale * dPdl[i], gv = g->cot_scale * dPdv[i];
+    const double* ri = r + (size_t)i * nv;
+    const double* dri = dr + (size_t)i * nv;
+    for (int j = 0; j < nv; j++) {
+      dq[j] += gl * ri[j] + gv * dri[j];
+      dqd[j] += gv * ri[j];
+    }
   }
   return val;
 }
@@ -457,19 +514,19 @@ static int integrand_grad_cb(void* vctx, int k, const double* z, double* dL) {
   if (g->cot_scale > 0) metabolic(g, (gait_ctx*)vctx, z, dL);
   for (int j = 0; j < L->nv; j++) {
     if (g->q_wt[j] > 0) {
-      dL[L->x_q + j] = 2 * g->q_wt[j] * (z[L->x_q + j] - g->q_ref[k * L->nv + j]);
+      dL[L->x_q + j] += 2 * g->q_wt[j] * (z[L->x_q + j] - g->q_ref[k * L->nv + j]);
     }
   }
   for (int c = 0; c < L->ngrf; c++) {
     if (g->grf_wt[c] > 0) {
-      dL[L->u_grf + c] = 2 * g->grf_wt[c] * (z[L->u_grf + c] - g->grf_ref[k * GO_GAIT_NGRF + c]);
+      dL[L->u_grf + c] += 2 * g->grf_wt[c] * (z[L->u_grf + c] - g->grf_ref[k * GO_GAIT_NGRF + c]);
     }
   }
   for (int i = 0; i < L->na; i++) {
-    dL[L->u_e + i] = 2 * g->w_effort * z[L->u_e + i];
+    dL[L->u_e + i] += 2 * g->w_effort * z[L->u_e + i];
   }
   for (int j = 0; g->w_accel > 0 && j < L->nv; j++) {
-    dL[L->xd_qdd + j] = 2 * g->w_accel * z[L->xd_qdd + j];
+    dL[L->xd_qdd + j] += 2 * g->w_accel * z[L->xd_qdd + j];
   }
   return 0;
 }
@@ -651,6 +708,7 @@ void go_gait_free(go_gait* g) {
   for (int w = 0; g->ctx && w < g->nthreads; w++) {
     if (g->ctx[w].d) mj_deleteData(g->ctx[w].d);
     free(g->ctx[w].M), free(g->ctx[w].P), free(g->ctx[w].Pm), free(g->ctx[w].zp);
+    free(g->ctx[w].mus), free(g->ctx[w].mom), free(g->ctx[w].dmom);
   }
   free(g->ctx);
   free(g->ctx_ptr);
@@ -1322,8 +1380,12 @@ static int setup_workers(go_gait* g, char* err, int errsz) {
     g->ctx[w].P = (double*)zalloc((size_t)na, sizeof(double));
     g->ctx[w].Pm = (double*)zalloc((size_t)na, sizeof(double));
     g->ctx[w].zp = (double*)zalloc((size_t)nz, sizeof(double));
+    g->ctx[w].mus = (double*)zalloc((size_t)4 * na, sizeof(double));
+    g->ctx[w].mom = (double*)zalloc((size_t)na * nv, sizeof(double));
+    g->ctx[w].dmom = (double*)zalloc((size_t)na * nv, sizeof(double));
     g->ctx_ptr[w] = &g->ctx[w];
-    if (!g->ctx[w].d || !g->ctx[w].M || !g->ctx[w].P || !g->ctx[w].Pm || !g->ctx[w].zp)
+    if (!g->ctx[w].d || !g->ctx[w].M || !g->ctx[w].P || !g->ctx[w].Pm || !g->ctx[w].zp ||
+        !g->ctx[w].mus || !g->ctx[w].mom || !g->ctx[w].dmom)
       return out_of_memory(err, errsz, "workers");
   }
   return 0;

@@ -375,6 +375,48 @@ int main(void) {
       for (int t = 0; t < GO_GAIT_NTERMS; t++) sc += tc[t];
       EXPECT_REL(go_nlp_objective_phys(go_gait_nlp(gc), fc), sc, 1e-12, 1e-14);
       EXPECT_TRUE(tc[GO_GAIT_TERM_COT] > 0 && tc[GO_GAIT_TERM_GRF] == 0);
+      // the metabolic gradient (chain rule through the actuator lengths and velocities and the
+      // moment arms' derivative along qdot, optim/go_gait.c metabolic) against differences of f
+      // over every variable: 1e-3 relative plus f's rounding over the step (the gradient's own
+      // central differences in l, v, a, e, fT are 1e-6 wide, the reference's about 6e-6; at the
+      // knee's flexion the two differ by 3e-4, a missing chain-rule term by O(1))
+      go_nlp* nc = go_gait_nlp(gc);
+      int nn, mc, ec;
+      go_nlp_sizes(nc, &nn, &mc, &ec);
+      double* gc_grad = malloc(sizeof(double) * (size_t)nn);
+      EXPECT_EQ_INT(0, go_nlp_eval_grad_f(nc, zs, gc_grad));
+      const go_gait_layout* Lc = go_gait_layout_get(gc);
+      int bad_cot = 0, n_q = 0;
+      double worst_cot = 0;
+      for (int v = 0; v < nn; v++) {
+        // Richardson's extrapolation of central differences at steps hv and hv / 2 (error
+        // O(hv^4): the knee's translations curve P within the plain difference's step)
+        double x0 = zs[v], hv = 6.0554544523933395e-06 * fmax(1.0, fabs(x0)), dv[2];
+        for (int s2 = 0; s2 < 2; s2++) {
+          double fp, fm, hs = s2 ? hv / 2 : hv;
+          zs[v] = x0 + hs;
+          double xp = zs[v];
+          go_nlp_eval_f(nc, zs, &fp);
+          zs[v] = x0 - hs;
+          double xm = zs[v];
+          go_nlp_eval_f(nc, zs, &fm);
+          zs[v] = x0;
+          dv[s2] = (fp - fm) / (xp - xm);
+        }
+        double ex = (4 * dv[1] - dv[0]) / 3;
+        double noise = 100 * 2.2e-16 * fmax(1.0, fabs(fc)) / hv, tol = 1e-3 * fabs(ex) + noise;
+        if (fabs(ex) > 1e3 * noise) worst_cot = fmax(worst_cot, fabs(gc_grad[v] - ex) / fabs(ex));
+        int j = v % Lc->nz;
+        if (v < 4 * Lc->nz && j >= Lc->x_q && j < Lc->x_q + 2 * Lc->nv && fabs(ex) > 1e-3) n_q++;
+        if (fabs(gc_grad[v] - ex) > tol && bad_cot++ < 5)
+          fprintf(stderr, "cot grad %d (node %d var %d): expected %.10g actual %.10g\n", v,
+                  v / Lc->nz, j, ex, gc_grad[v]);
+      }
+      printf("cost-of-transport gradient: worst relative error %.2e (entries above 1e3 times "
+             "the rounding noise); %d entries above 1e-3 in q, qdot\n", worst_cot, n_q);
+      EXPECT_EQ_INT(0, bad_cot);
+      EXPECT_TRUE(n_q > 20);
+      free(gc_grad);
       go_nlp_scale_z(a, z, zs);
       go_gait_free(gc);
     }

@@ -870,7 +870,9 @@ static const char* kPredictUsage =
     "transport and peak triceps surae excitations. Exit status 3 when the solver stopped short.\n\n"
     "  --model FILE        MJCF model (default: the one TRACK_DIR/summary.json names, else\n"
     "                      mjmodels/jw_fullbody_knee6.xml)\n"
-    "  --nodes N           collocation nodes (default " GO_STR(GO_NODES_PREDICT) ")\n"
+    "  --nodes N           collocation nodes (default: the guess's, TRACK_DIR/summary.json\n"
+    "                      nodes, so an 80-node tracking solution is continued on 80; else\n"
+    "                      " GO_STR(GO_NODES_PREDICT) ")\n"
     "  --threads N         worker threads (default " GO_STR(GO_THREADS) ")\n"
     "  --max-iter N        Ipopt iteration limit (default " GO_STR(GO_MAX_ITER) ")\n"
     "  --max-time S        wall-clock limit, s (default none)\n"
@@ -934,7 +936,7 @@ int gs_cmd_predict(int argc, char** argv) {
   o.min_vgrf = GO_PREDICT_MIN_VGRF;
   optind = 1;
   opterr = 0;
-  int c, bad = 0, model_given = 0;
+  int c, bad = 0, model_given = 0, nodes_given = 0;
   char err[256];
   while (!bad && (c = getopt_long(argc, argv, ":g:s:o:m:n:t:i:T:w:PFS:R:W:D:E:p:h", options,
                                   NULL)) != -1) {
@@ -946,7 +948,10 @@ int gs_cmd_predict(int argc, char** argv) {
         o.model = optarg;
         model_given = 1;
         break;
-      case 'n': bad = gs_opt_int("--nodes", optarg, GS_MIN_NODES, GS_MAX_NODES, &o.nodes); break;
+      case 'n':
+        bad = gs_opt_int("--nodes", optarg, GS_MIN_NODES, GS_MAX_NODES, &o.nodes);
+        nodes_given = 1;
+        break;
       case 't': bad = gs_opt_int("--threads", optarg, 1, 64, &o.threads); break;
       case 'i': bad = gs_opt_int("--max-iter", optarg, 0, GS_OPT_NO_MAX, &o.plan.max_iter); break;
       case 'T':
@@ -990,6 +995,10 @@ int gs_cmd_predict(int argc, char** argv) {
   static char guess_model[4096];
   if (!model_given && gs_app_solution_model(o.guess, guess_model, (int)sizeof(guess_model)))
     o.model = guess_model;
+  // and its mesh unless --nodes: the prediction continues the solution at its resolution
+  int guess_nodes = gs_app_solution_nodes(o.guess);
+  if (!nodes_given && guess_nodes >= GS_MIN_NODES && guess_nodes <= GS_MAX_NODES)
+    o.nodes = guess_nodes;
   return solve(o);
 }
 

@@ -38,7 +38,7 @@ static const char* kSweepUsage =
     "SIGTERM, SIGHUP) reaches both processes: the running solves write their best iterates and\n"
     "DIR holds the speeds solved, the table saying which were not (exit 3); a second signal\n"
     "ends the sweep at once and DIR stays as it was. No speed solved: DIR stays as it was.\n\n"
-    "  --nodes N       collocation nodes (default " GO_STR(GO_NODES_PREDICT) ")\n"
+    "  --nodes N       collocation nodes (default: the guess's, as gaitsim predict)\n"
     "  --max-time S    wall-clock limit of each solve, s (default none: the iteration limit,\n"
     "                  so that the results do not depend on the load of the machine)\n"
     "  --max-iter N    Ipopt iteration limit of each solve (default " GO_STR(GO_MAX_ITER_SWEEP)
@@ -84,11 +84,19 @@ static int solve_one(const char* guess, double v, const char* out, const char* n
   int saved = dup(2);
   FILE* lf = fopen(log, "w");
   if (lf) dup2(fileno(lf), 2);
-  char* argv[] = {"predict", "--guess", (char*)guess, "--speed", speed, "--out", (char*)out,
-                  "--nodes", (char*)nodes, "--threads", "1", "--max-iter", (char*)max_iter,
-                  max_time ? "--max-time" : NULL, (char*)max_time, NULL};
-  int argc = 0;  // the words before the first NULL (no --max-time without a limit)
-  while (argv[argc]) argc++;
+  // --nodes and --max-time only when given (predict then takes the guess's node count)
+  char* argv[16] = {"predict", "--guess", (char*)guess, "--speed", speed, "--out", (char*)out,
+                    "--threads", "1", "--max-iter", (char*)max_iter};
+  int argc = 11;
+  if (nodes) {
+    argv[argc++] = "--nodes";
+    argv[argc++] = (char*)nodes;
+  }
+  if (max_time) {
+    argv[argc++] = "--max-time";
+    argv[argc++] = (char*)max_time;
+  }
+  argv[argc] = NULL;
   int rc = gs_cmd_predict(argc, argv);
   fflush(stderr);
   if (lf) {
@@ -139,7 +147,7 @@ int gs_cmd_sweep(int argc, char** argv) {
       {"max-time", required_argument, NULL, 'T'}, {"max-iter", required_argument, NULL, 'i'},
       {"help", no_argument, NULL, 'h'},
       {NULL, 0, NULL, 0}};
-  const char *guess = NULL, *dir = NULL, *nodes = GO_STR(GO_NODES_PREDICT), *max_time = NULL;
+  const char *guess = NULL, *dir = NULL, *nodes = NULL, *max_time = NULL;
   const char* max_iter = GO_STR(GO_MAX_ITER_SWEEP);
   double v[SWEEP_MAX_SPEEDS];
   int n = -1, c, bad = 0;

@@ -133,6 +133,19 @@ const char* gs_app_solution_model(const char* dir, char* buf, int n) {
   return found;
 }
 
+int gs_app_solution_nodes(const char* dir) {
+  char path[4096];
+  snprintf(path, sizeof(path), "%s/summary.json", dir);
+  cJSON* j = gs_app_read_json(path);
+  const cJSON* nodes = j ? cJSON_GetObjectItemCaseSensitive(j, "nodes") : NULL;
+  int n = -1;
+  if (cJSON_IsNumber(nodes) && nodes->valuedouble >= 1 && nodes->valuedouble <= 1e6 &&
+      nodes->valuedouble == (double)(int)nodes->valuedouble)
+    n = (int)nodes->valuedouble;
+  cJSON_Delete(j);
+  return n;
+}
+
 int gs_app_check_solution(const char* dir, int require_summary) {
   char path[4096], err[1024];
   struct stat st;

@@ -33,6 +33,10 @@ struct cJSON* gs_app_read_json(const char* path);
 // file is gone).
 const char* gs_app_solution_model(const char* dir, char* buf, int n);
 
+// The node count a solution folder was solved on: the "nodes" of DIR/summary.json, or -1 (no
+// summary, no such entry, not a positive integer).
+int gs_app_solution_nodes(const char* dir);
+
 // Check a solution folder before it is read (predict --guess, track --init, render, report,
 // sweep --guess): DIR is a folder with states.sto; summary.json, when present (required with
 // require_summary), is valid JSON; every storage file of the folder reads without error; and

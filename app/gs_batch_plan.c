@@ -11,6 +11,7 @@
 #include <cjson/cJSON.h>
 
 #include "io/gs_text.h"
+#include "optim/go_defaults.h"
 #include "optim/go_ipopt.h"
 
 enum { KIND_TRACK = 1, KIND_PREDICT = 2 };  // bits: the commands an option belongs to
@@ -448,7 +449,8 @@ static int fill_solve(gsBatchPlan* p, const cJSON* root, const cJSON* e, int idx
   // (measured peak of the full-body track with L-BFGS: 120 MB at 20 nodes, 238 MB at 80; the
   // exact-Hessian refinement's factorisation needs more, a margin left for it, not measured)
   s->cpus = arg_int(s, "--threads", 2);
-  int nodes = arg_int(s, "--nodes", s->kind == GS_BATCH_TRACK ? 80 : 20);
+  // (a prediction without --nodes solves on its guess's mesh: the tracking default bounds it)
+  int nodes = arg_int(s, "--nodes", GO_NODES_TRACK);
   int iter = arg_int(s, "--max-iter", 1000);  // both commands' default
   s->time_min = 10 + (int)(0.05 * nodes * iter / 60);
   s->mem_mb = 1024 + 20 * nodes;

@@ -11,7 +11,8 @@
 // collocation nodes per stride (-)
 #define GO_NODES_TRACK 80     // gaitsim track, and go_gait_opts_default: the paper's resolution
                               // (Lin, Walter & Pandy 2018)
-#define GO_NODES_PREDICT 20   // gaitsim predict and sweep (each prediction of a sweep)
+#define GO_NODES_PREDICT 20   // gaitsim predict and sweep when the guess's summary.json gives no
+                              // node count (else they solve on the guess's mesh)
 #define GO_NODES_MAIN_JOB 20  // gaitsim run's main job (its tracking solve, then its sweep): the
                               // main job's resolution until 80-node solves converge in its time
                               // budget (issue #19); more nodes are solved on this many first and

@@ -4,8 +4,8 @@
 # polished towards the dynamics (violation down 10-fold from the guess's; from this far the
 # polish does not reach feasibility), every file is written (metabolics.sto: the muscles and
 # their total; knee_contact.sto: both knees) and summary.json carries the prediction figures and
-# the peak knee contact of both knees; bad usage exits 2, a missing guess exits 1
-# with one line naming the folder.
+# the peak knee contact of both knees; a prediction from it without --nodes solves on its 5
+# nodes; bad usage exits 2, a missing guess exits 1 with one line naming the folder.
 # usage: predict.sh GAITSIM SOURCE_DIR
 set -u
 gaitsim=$1 src=$2
@@ -74,6 +74,13 @@ if not ok:
     print(s, last and last.groups(), file=sys.stderr)
 sys.exit(0 if ok else 1)
 PY
+
+# without --nodes a prediction continues its guess on the guess's mesh (summary.json nodes: 5),
+# not on GO_NODES_PREDICT's 20
+"$gaitsim" predict --guess pred --speed 0.9 --out pred2 --max-iter 0 --no-polish --threads 1 \
+  >/dev/null 2>&1
+check "no --nodes: the guess's 5 nodes" /usr/bin/python3 -c \
+  'import json, sys; sys.exit(json.load(open("pred2/summary.json"))["nodes"] != 5)'
 
 "$gaitsim" predict --speed 0.8 --out x >/dev/null 2>&1
 check "no --guess: usage, exit 2" test $? -eq 2

@@ -99,6 +99,12 @@ static const char* kTrackUsageSolver =
     "                      where they stop (default "
     GO_STR(GO_REFINE_GN_ITER) ";\n"
     "                      0: none; summary.json refine.gauss_newton)\n"
+    "  --refine-after N    the L-BFGS solve hands over to the refinement at its first\n"
+    "                      iterate from iteration N on at a violation <= 1e-3 (a point the\n"
+    "                      refinement and the polish can start from; status \"handed over to\n"
+    "                      the refinement\"), --max-iter staying its cap (default "
+    GO_STR(GO_HANDOVER_ITER_TRACK) ";\n"
+    "                      0: L-BFGS runs to --max-iter)\n"
     "  --refine-time S     the refinement's wall-clock limit in seconds (default "
     GO_STR(GO_REFINE_WALL_S) ";\n"
     "                      --max-time, when given, caps it too)\n"
@@ -160,6 +166,7 @@ static void defaults(gsTrackOptions* o) {
   o->activation = GO_ACTIVATION;
   go_solve_plan_default(&o->plan);
   o->plan.max_iter = GO_MAX_ITER_TRACK;
+  o->plan.handover_iter = GO_HANDOVER_ITER_TRACK;
   o->plan.progress = stderr;
   o->w_pelvis_rot = GO_TRACK_W_PELVIS_ROT;
   o->w_pelvis_trans = GO_TRACK_W_PELVIS_TRANS;
@@ -189,6 +196,7 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
       {"refine", required_argument, NULL, 'r'},
       {"refine-time", required_argument, NULL, 'W'},
       {"refine-gn", required_argument, NULL, 'g'},
+      {"refine-after", required_argument, NULL, 'A'},
       {"help", no_argument, NULL, 'h'},           {NULL, 0, NULL, 0}};
   static const char* const hessians[] = {"lbfgs", "pqn", "exact", "gauss-newton", NULL};
   static const go_hessian_kind kinds[] = {GO_HESSIAN_LBFGS, GO_HESSIAN_PQN, GO_HESSIAN_EXACT,
@@ -199,7 +207,7 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
   opterr = 0;
   int c, bad = 0, k;
   while (!bad &&
-         (c = getopt_long(argc, argv, ":o:m:n:t:i:T:a:p:H:w:I:G:R:r:W:g:Ph", options, NULL)) != -1) {
+         (c = getopt_long(argc, argv, ":o:m:n:t:i:T:a:p:H:w:I:G:R:r:W:g:A:Ph", options, NULL)) != -1) {
     switch (c) {
       case 'o': o->out = optarg; break;
       case 'm': o->model = optarg; break;
@@ -220,6 +228,9 @@ static int parse(int argc, char** argv, gsTrackOptions* o) {
         break;
       case 'g':
         bad = gs_opt_int("--refine-gn", optarg, 0, GS_OPT_NO_MAX, &o->plan.refine_gn_iter);
+        break;
+      case 'A':
+        bad = gs_opt_int("--refine-after", optarg, 0, GS_OPT_NO_MAX, &o->plan.handover_iter);
         break;
       case 'W':
         bad = gs_opt_real("--refine-time", optarg, 0, HUGE_VAL, GS_OPT_LO_OPEN,

@@ -54,6 +54,7 @@ static const optRule kRules[] = {
     {"refine", KIND_TRACK, OPT_INT, 0, 1000000, 0, NULL},
     {"refine-gn", KIND_TRACK, OPT_INT, 0, 1000000, 0, NULL},
     {"refine-time", KIND_TRACK, OPT_NUM, 0, INFINITY, 1, NULL},
+    {"refine-after", KIND_TRACK, OPT_INT, 0, 1000000, 0, NULL},
     {"init", KIND_TRACK, OPT_SOLUTION, 0, 0, 0, NULL},
     {"no-fibre-bounds", KIND_PREDICT, OPT_FLAG, 0, 0, 0, NULL},
     {"metabolic-smoothing", KIND_PREDICT, OPT_NUM, 0, 1e3, 1, NULL},

@@ -21,12 +21,14 @@
 #define GO_THREADS 2
 // Ipopt iteration limits (-)
 #define GO_MAX_ITER 1000           // predict (--max-iter)
-#define GO_MAX_ITER_TRACK 150      // track's L-BFGS solve, before the refinement (--max-iter):
-                                   // at N = 80 the refinement settles from its best iterate
-                                   // after 150 (J 3.09) at J 2.653 and from the one after 300
-                                   // (J 2.87) at 2.641, the Table 1 figures equal to 2 digits,
-                                   // 5 minutes sooner (docs/BENCHMARKS.md, "A shorter L-BFGS
-                                   // phase")
+#define GO_MAX_ITER_TRACK 300      // track's L-BFGS solve, before the refinement (--max-iter)
+#define GO_HANDOVER_ITER_TRACK 150 // ... which hands over to the refinement at its first
+                                   // iterate from this iteration on at a violation <= 1e-3
+                                   // (--refine-after): on jw_ngait_og5 at N = 80 the refinement
+                                   // settled from such a point at J 2.653 and from the best
+                                   // iterate after 300 at 2.641, the Table 1 figures equal to 2
+                                   // digits, 5 minutes sooner; jw_bouncy7 had none in its
+                                   // first 150 (docs/BENCHMARKS.md, "A shorter L-BFGS phase")
 #define GO_MAX_ITER_SWEEP 1500     // each prediction of sweep and of run's main job: an
                                    // iteration budget, not a time limit, so results do not
                                    // depend on the load of the machine

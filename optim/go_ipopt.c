@@ -228,7 +228,7 @@ typedef struct {
   double low_obj;   // lowest physical objective of iterations with inf_pr <= fallback_viol
   int have_low_obj;
   int stop_reason;  // 0 none, 1 interrupted, 2 wall time, 3 fell back (fallback_rise),
-                    // 4 settled (settle_iter)
+                    // 4 settled (settle_iter), 5 handed over (handover_iter)
   int settle_it[GO_IPOPT_MAX_SETTLE];    // the latest iterations near feasibility, newest last
   double settle_J[GO_IPOPT_MAX_SETTLE];  // their physical objectives
   int settle_n;                          // entries used (at most settle_iter)
@@ -409,6 +409,15 @@ static Bool cb_iter(Index alg_mod, Index iter, Number obj, Number inf_pr, Number
     s->stop_reason = 4;
     return FALSE;
   }
+  if (s->opts->handover_iter > 0 && iter >= s->opts->handover_iter && !alg_mod &&
+      inf_pr <= s->opts->handover_viol) {
+    if (s->opts->progress)
+      fprintf(s->opts->progress, "handed over: iteration %d (from %d on) at inf_pr <= %.0e; "
+              "stopping for the refinement\n", (int)iter, s->opts->handover_iter,
+              s->opts->handover_viol);
+    s->stop_reason = 5;
+    return FALSE;
+  }
   if (s->opts->fallback_rise > 0 && !alg_mod && isfinite(obj)) {
     double J = go_nlp_objective_phys(s->nlp, obj);
     if (s->have_low_obj && J > s->low_obj + s->opts->fallback_rise * fabs(s->low_obj)) {
@@ -439,7 +448,8 @@ static go_solve_status map_status(int st, int stop_reason) {
       return stop_reason == 1 ? GO_SOLVE_INTERRUPTED
              : stop_reason == 2 ? GO_SOLVE_MAX_WALL_TIME
              : stop_reason == 3 ? GO_SOLVE_FELL_BACK
-             : stop_reason == 4 ? GO_SOLVE_SETTLED : GO_SOLVE_INTERNAL_ERROR;
+             : stop_reason == 4 ? GO_SOLVE_SETTLED
+             : stop_reason == 5 ? GO_SOLVE_HANDED_OVER : GO_SOLVE_INTERNAL_ERROR;
     case Maximum_Iterations_Exceeded: return GO_SOLVE_MAX_ITER;
     case Maximum_CpuTime_Exceeded: return GO_SOLVE_MAX_CPU_TIME;
     case Restoration_Failed: return GO_SOLVE_RESTORATION_FAILED;
@@ -471,6 +481,7 @@ const char* go_solve_status_str(go_solve_status st) {
     case GO_SOLVE_BAD_OPTION: return "invalid option";
     case GO_SOLVE_FELL_BACK: return "fell back from the solution it had reached";
     case GO_SOLVE_SETTLED: return "objective settled";
+    case GO_SOLVE_HANDED_OVER: return "handed over to the refinement";
     case GO_SOLVE_INTERNAL_ERROR: return "internal error";
   }
   return "unknown status";

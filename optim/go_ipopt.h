@@ -64,6 +64,11 @@ typedef struct {
                           // one violation spike resets); 0: off; at most GO_IPOPT_MAX_SETTLE
   double settle_rel;      // the settled rule's relative objective change per iteration (-)
   double settle_viol;     // violation (scaled, max norm, Ipopt's inf_pr) of the settled rule
+  int handover_iter;      // > 0: stop (GO_SOLVE_HANDED_OVER) at the first iteration from this
+                          // one on, outside the restoration phase, with inf_pr <=
+                          // handover_viol: an L-BFGS solve that has a point the exact-Hessian
+                          // refinement can start from (go_solve.h); 0: off
+  double handover_viol;   // violation (scaled, max norm, Ipopt's inf_pr) of handover_iter
   int n_kv;               // extra Ipopt options, applied after all of the above, in order
   go_ipopt_kv kv[GO_IPOPT_MAX_OPTIONS];
 } go_ipopt_opts;
@@ -88,6 +93,8 @@ typedef enum {
                                // lowest one reached near feasibility
   GO_SOLVE_SETTLED,            // stopped by settle_iter: the objective settled near feasibility
                                // (the best iterate is the point to use)
+  GO_SOLVE_HANDED_OVER,        // stopped by handover_iter: near feasibility after enough
+                               // iterations, for the refinement to go on from
   GO_SOLVE_INTERNAL_ERROR,     // exceptions, memory, internal errors, user stop of unknown cause
 } go_solve_status;
 

@@ -228,6 +228,9 @@ static int main_solve(run_state* s, go_ipopt_opts* opts, go_solve_report* rep, c
               res->best_iter, res->best_objective, res->best_viol);
     go_ipopt_opts ro = *opts;
     if (p->max_iter >= 0) ro.max_iter = p->max_iter - res->iterations;
+    if (ro.handover_iter > 0)  // counted from the main solve's start
+      ro.handover_iter = ro.handover_iter > res->iterations ? ro.handover_iter - res->iterations
+                                                            : 1;
     if (p->max_wall_s > 0) ro.max_wall_s = p->max_wall_s - res->wall_s;
     char why[512];
     if (set_start_near_solution(&ro, why, sizeof(why)) != 0) {
@@ -270,6 +273,7 @@ static int refine(run_state* s, const go_ipopt_opts* opts, go_solve_report* rep,
                                     : p->refine_wall_s;
   go_ipopt_opts ro = *opts;
   ro.max_wall_s = budget;
+  ro.handover_iter = 0;
   if (set_start_near_solution(&ro, why, sizeof(why)) != 0) {
     snprintf(err, (size_t)errsz, "refine: %s", why);
     return -1;
@@ -443,6 +447,10 @@ static int run_stages(run_state* s, go_solve_report* rep, char* err, int errsz) 
     return -1;
   }
   opts.hess = s->hess;
+  if (p->handover_iter > 0 && p->refine_iter > 0 && p->hessian == GO_HESSIAN_LBFGS) {
+    opts.handover_iter = p->handover_iter;
+    opts.handover_viol = opts.best_viol_tol;
+  }
   memcpy(s->z, p->z0, sizeof(double) * (size_t)s->n);
   if (main_solve(s, &opts, rep, err, errsz) != 0 || refine(s, &opts, rep, err, errsz) != 0)
     return -1;

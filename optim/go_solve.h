@@ -5,7 +5,8 @@
 //   2. restarts: after a fall-back (GO_SOLVE_FELL_BACK: Ipopt came near a solution, violation
 //      <= fallback_viol, and left it), again from the best iterate with the iterations and time
 //      left, a small barrier and the point barely pushed off its bounds; at most max_restarts;
-//   3. refinement: an L-BFGS solve that stopped short (not converged, not interrupted) is
+//   3. refinement: an L-BFGS solve that stopped short (not converged, not interrupted; with
+//      handover_iter, at its first nearly feasible iterate from that iteration on) is
 //      followed, from its best iterate, by refine_gn_iter Gauss-Newton iterations (the goals'
 //      Hessian, positive semi-definite) and, from where they stop, up to refine_iter Newton
 //      iterations with the exact Hessian (structured finite differences, go_hess_create_fd),
@@ -72,6 +73,10 @@ typedef struct {
   int max_restarts;           // restarts after a fall-back, at most (-; GO_MAX_RESTARTS at
                               // most, the size of go_solve_report.restarts)
   int refine_iter;            // refinement's Newton iterations at most (-); 0: no refinement
+  int handover_iter;          // > 0 with a refinement after an L-BFGS main solve: that solve
+                              // hands over to the refinement at its first iterate from this
+                              // iteration on at a violation the polish takes (ipopt.best_viol_tol;
+                              // go_ipopt_opts.handover_iter), max_iter staying its cap; 0: off
   double refine_wall_s;       // refinement's wall-clock cap (s), or less when max_wall_s says
   int refine_gn_iter;         // Gauss-Newton iterations before the refinement's Newton ones (-);
                               // 0: none

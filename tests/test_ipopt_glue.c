@@ -173,6 +173,23 @@ int main(void) {
   EXPECT_EQ_INT(it_tight, r.iterations);
   EXPECT_NEAR(j_tight, r.objective, 1e-12);
 
+  // hand-over: from iteration 2 on, at the first iterate at any violation (1e10) the solve stops
+  // with its own status, exactly at iteration 2; at a violation no iterate reaches it never fires
+  go_ipopt_opts_default(&o);
+  o.tol = 1e-12;
+  o.handover_iter = 2;
+  o.handover_viol = 1e10;
+  guess(z);
+  EXPECT_EQ_INT(0, solve(nlp, &o, z, zb, NULL, &r, &rc, err));
+  EXPECT_EQ_INT(GO_SOLVE_HANDED_OVER, r.status);
+  EXPECT_EQ_INT(2, r.iterations);
+  EXPECT_TRUE(strcmp(go_solve_status_str(r.status), "handed over to the refinement") == 0);
+  o.handover_viol = 1e-30;
+  guess(z);
+  EXPECT_EQ_INT(0, solve(nlp, &o, z, zb, NULL, &r, &rc, err));
+  EXPECT_EQ_INT(GO_SOLVE_SUCCESS, r.status);
+  EXPECT_EQ_INT(it_tight, r.iterations);
+
   // ./ipopt.opt in the working directory is not read (it would stop after 1 iteration and print)
   char cwd[4096], dir[] = "/tmp/gs_test_ipoptopt_XXXXXX";
   EXPECT_TRUE(getcwd(cwd, sizeof(cwd)) != NULL);

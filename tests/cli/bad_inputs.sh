@@ -74,6 +74,8 @@ expect "track --max-iter -3" 2 '^gaitsim: --max-iter: must be an integer >= 0 \(
   "$G" "${T[@]}" --max-iter -3
 expect "track --max-time 0" 2 '^gaitsim: --max-time: must be a number > 0 \(got 0\)$' keep \
   "$G" "${T[@]}" --max-time 0
+expect "track --refine-after -1" 2 '^gaitsim: --refine-after: .*\(got -1\)$' keep \
+  "$G" "${T[@]}" --refine-after -1
 expect "track --refine-time 0" 2 '^gaitsim: --refine-time: must be a number > 0 \(got 0\)$' keep \
   "$G" "${T[@]}" --refine-time 0
 expect "track --max-time inf" 2 '^gaitsim: --max-time: .*\(got inf\)$' keep "$G" "${T[@]}" --max-time inf

@@ -321,7 +321,12 @@ sweep_and_signal sw TERM TERM
 status=$?
 check "sweep two SIGTERMs: ended by SIGTERM (status $status)" test "$status" -eq 143
 check "sweep two SIGTERMs: the earlier sweep untouched" test "$before" = "$(snap sw)"
-sleep 0.5  # the second process ends by its own second signal
+# the second process ends by its own second signal: wait for it up to 20 s (0.5 s was too short
+# on a loaded machine)
+for _ in $(seq 100); do
+  [ -z "$(pgrep -f "sweep --guess sol --speeds $down2")" ] && break
+  sleep 0.2
+done
 check "sweep two SIGTERMs: no temporary folder" no_tmp sw
 check "sweep two SIGTERMs: no process left" test -z "$(pgrep -f "sweep --guess sol --speeds $down2")"
 

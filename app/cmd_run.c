@@ -166,8 +166,7 @@ int gs_cmd_run(int argc, char** argv) {
   printf("[1] tracking solve of %s, %s nodes -> %s\n", trial, continued ? main_nodes : nodes,
          continued ? coarse : track);
   const char* w1[] = {"track", trial, "--out", continued ? coarse : track, "--nodes", main_nodes,
-                      "--threads", threads, "--max-iter", GO_STR(GO_MAX_ITER_MAIN_TRACK),
-                      "--refine-after", "0", NULL};
+                      "--threads", threads, "--max-iter", GO_STR(GO_MAX_ITER_MAIN_TRACK), NULL};
   rc = sub(gs_cmd_track, w1);
   if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
   stopped_short |= rc == GS_EXIT_STOPPED_SHORT;
@@ -175,8 +174,7 @@ int gs_cmd_run(int argc, char** argv) {
   if (continued) {
     printf("[1] tracking solve, %s nodes, started from it -> %s\n", nodes, track);
     const char* w2[] = {"track", trial, "--out", track, "--nodes", nodes, "--threads", threads,
-                        "--init", coarse, "--max-iter", GO_STR(GO_MAX_ITER_MAIN_CONTINUED),
-                        "--refine-after", "0", NULL};
+                        "--init", coarse, "--max-iter", GO_STR(GO_MAX_ITER_MAIN_CONTINUED), NULL};
     rc = sub(gs_cmd_track, w2);
     if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
     stopped_short |= rc == GS_EXIT_STOPPED_SHORT;

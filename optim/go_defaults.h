@@ -22,13 +22,14 @@
 // Ipopt iteration limits (-)
 #define GO_MAX_ITER 1000           // predict (--max-iter)
 #define GO_MAX_ITER_TRACK 300      // track's L-BFGS solve, before the refinement (--max-iter)
-#define GO_HANDOVER_ITER_TRACK 150 // ... which hands over to the refinement at its first
-                                   // iterate from this iteration on at a violation <= 1e-3
-                                   // (--refine-after): on jw_ngait_og5 at N = 80 the refinement
-                                   // settled from such a point at J 2.653 and from the best
-                                   // iterate after 300 at 2.641, the Table 1 figures equal to 2
-                                   // digits, 5 minutes sooner; jw_bouncy7 had none in its
-                                   // first 150 (docs/BENCHMARKS.md, "A shorter L-BFGS phase")
+#define GO_HANDOVER_ITER_TRACK 0   // ... and with --refine-after N > 0 hands over to the
+                                   // refinement at its first iterate from iteration N on at a
+                                   // violation <= 1e-3. Off: on jw_ngait_og5 at N = 80, N = 150
+                                   // handed over at iteration 230 and the whole solve took as
+                                   // long (1097 s against 1140 s, J 2.649 against 2.641); a flat
+                                   // 150-iteration cap was 4 minutes faster there but left
+                                   // jw_bouncy7 without a usable start (docs/BENCHMARKS.md, "A
+                                   // shorter L-BFGS phase")
 #define GO_MAX_ITER_SWEEP 1500     // each prediction of sweep and of run's main job: an
                                    // iteration budget, not a time limit, so results do not
                                    // depend on the load of the machine

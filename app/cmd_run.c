@@ -48,7 +48,7 @@ static const char* kRunUsage =
     "                 budget, not a time limit, so that the results do not depend on the load\n"
     "                 of the machine; in the measured main job (docs/BENCHMARKS.md) they\n"
     "                 reached Ipopt's acceptable level after 421 (0.8 m/s) and 396 (2.0 m/s)\n"
-    "                 iterations, under 5 minutes each, on 2 cores)\n"
+    "                 iterations, about 3 minutes each side by side on 2 cores)\n"
     "  --max-time S   wall-clock limit of each predictive solve, s (default none); the tracking\n"
     "                 solve stops after " GO_STR(GO_MAX_ITER_MAIN_TRACK) " iterations ("
     GO_STR(GO_MAX_ITER_MAIN_CONTINUED) " on a continued mesh)\n";

@@ -133,15 +133,23 @@ const char* gs_app_solution_model(const char* dir, char* buf, int n) {
   return found;
 }
 
+// the "nodes" of a parsed summary.json: 1 with *nodes set when it is a node count (an integer
+// in [1, 1e6]), 0 when absent, -1 when present but not a node count
+static int summary_nodes(const cJSON* summary, int* nodes) {
+  const cJSON* n = cJSON_GetObjectItemCaseSensitive(summary, "nodes");
+  if (!n) return 0;
+  double v = cJSON_IsNumber(n) ? n->valuedouble : 0;
+  if (!(cJSON_IsNumber(n) && v >= 1 && v <= 1e6 && v == floor(v))) return -1;
+  *nodes = (int)v;
+  return 1;
+}
+
 int gs_app_solution_nodes(const char* dir) {
   char path[4096];
   snprintf(path, sizeof(path), "%s/summary.json", dir);
   cJSON* j = gs_app_read_json(path);
-  const cJSON* nodes = j ? cJSON_GetObjectItemCaseSensitive(j, "nodes") : NULL;
   int n = -1;
-  if (cJSON_IsNumber(nodes) && nodes->valuedouble >= 1 && nodes->valuedouble <= 1e6 &&
-      nodes->valuedouble == (double)(int)nodes->valuedouble)
-    n = (int)nodes->valuedouble;
+  if (!j || summary_nodes(j, &n) != 1) n = -1;
   cJSON_Delete(j);
   return n;
 }
@@ -164,14 +172,11 @@ int gs_app_check_solution(const char* dir, int require_summary) {
               "folder?)\n", path);
       return -1;
     }
-    const cJSON* n = cJSON_GetObjectItemCaseSensitive(j, "nodes");
-    double v = cJSON_IsNumber(n) ? n->valuedouble : 1;
-    if (n && !(cJSON_IsNumber(n) && v >= 1 && v <= 1e6 && v == floor(v))) {
+    if (summary_nodes(j, &nodes) < 0) {
       fprintf(stderr, "gaitsim: %s: \"nodes\" is not a node count\n", path);
       cJSON_Delete(j);
       return -1;
     }
-    if (n) nodes = (int)v;
     cJSON_Delete(j);
   } else if (require_summary) {
     fprintf(stderr, "gaitsim: %s: no summary.json: not a complete solution folder\n", dir);

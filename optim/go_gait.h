@@ -69,7 +69,8 @@
 // predictive problem; its scale is qddot's variable scale below. With w_cot > 0 the integrand
 // gains w_cot Edot / (m V) (J = w_cot COT + ...; its gradient by the chain rule through each
 // actuator's length and velocity and the moment arms' derivative along qdot, with central
-// differences of the muscle model in e, a, fT, l and v; no Hessian term). go_gait_objective_terms splits J into these goals.
+// differences of the muscle model in e, a, fT, l and v; no Hessian term).
+// go_gait_objective_terms splits J into these goals.
 //
 // Boundary: periodicity of every state but pelvis_tx (and the coordinates named in free_coords),
 // and of the excitations; optionally mean speed (tx_last - tx_first) / T = speed.

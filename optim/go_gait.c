@@ -39,6 +39,9 @@ typedef struct {
   double* mus;        // per-muscle scratch of the metabolic gradient (4 na)
   double* mom;        // actuator moment arms at the node (na x nv, m or m/rad)
   double* dmom;       // their derivative along qdot (na x nv, m/s or m/(rad s))
+  double* pos_q;      // the coordinates d's position stage was computed at (nv, m or rad)
+  int pos_valid;      // 1: d's position stage is that of pos_q (see node_inverse)
+  long pos_reused;    // node_inverse calls that reused it
 } gait_ctx;
 
 #define GO_GAIT_MAX_MUSCLES 512
@@ -128,7 +131,9 @@ double go_gait_grf_ref(const go_gait* g, int k, int c) {
 
 // --- evaluation -------------------------------------------------------------------------------
 
-void go_gait_load_node(const go_gait* g, mjData* d, const double* z) {
+// node z's inputs of the inverse dynamics into d: coordinates, speeds, accelerations,
+// activations, excitations and (userdata) normalised tendon forces
+static void set_node_inputs(const go_gait* g, mjData* d, const double* z) {
   const go_gait_layout* L = &g->L;
   const mjModel* m = g->m;
   mju_copy(d->qpos, z + L->x_q, L->nv);
@@ -140,7 +145,42 @@ void go_gait_load_node(const go_gait* g, mjData* d, const double* z) {
   for (int e = 0; e < L->ne; e++) {
     d->userdata[L->elastic[e]] = z[L->x_ft + e];
   }
-  mj_inverse(m, d);
+}
+
+void go_gait_load_node(const go_gait* g, mjData* d, const double* z) {
+  set_node_inputs(g, d, z);
+  mj_inverse(g->m, d);
+}
+
+// go_gait_load_node on the worker's data, reusing its position stage when z's coordinates equal
+// (bitwise) those it was computed at. MuJoCo's position stage (kinematics, tendon paths, moment
+// arms, mass matrix) depends on qpos alone and the velocity and acceleration stages only read it,
+// so mj_inverseSkip(mjSTAGE_POS) then gives the same numbers as mj_inverse, bitwise
+// (tests/test_gait_problem.c checks it). Finite differences in the speeds, activations,
+// excitations and tendon forces of one node hit it: about half the path evaluations of a
+// Jacobian and of an exact Hessian (docs/BENCHMARKS.md, "The position stage reused").
+static void node_inverse(gait_ctx* c, const double* z) {
+  const go_gait* g = c->g;
+  mjData* d = c->d;
+  int nv = g->L.nv;
+  set_node_inputs(g, d, z);
+  if (c->pos_valid && memcmp(c->pos_q, z + g->L.x_q, sizeof(double) * (size_t)nv) == 0) {
+    mj_inverseSkip(g->m, d, mjSTAGE_POS, 0);
+    c->pos_reused++;
+    return;
+  }
+  mj_inverse(g->m, d);
+  memcpy(c->pos_q, z + g->L.x_q, sizeof(double) * (size_t)nv);
+  c->pos_valid = 1;
+}
+
+// d's position stage is about to be changed by something else than node_inverse
+static void forget_position(gait_ctx* c) { c->pos_valid = 0; }
+
+long go_gait_position_reuses(const go_gait* g) {
+  long s = 0;
+  for (int w = 0; w < g->nthreads; w++) s += g->ctx[w].pos_reused;
+  return s;
 }
 
 // tension (N) of muscle i at the loaded state; dF/da into *dFda for rigid tendons (else 0)
@@ -179,11 +219,11 @@ void go_gait_fibre_lengths(const go_gait* g, mjData* d, const double* z, double*
   for (int i = 0; i < g->L.na; i++) lm_norm[i] = fibre_norm(g, d, z, i, NULL);
 }
 
-int go_gait_path_eval(const go_gait* g, mjData* d, const double* z, double* res) {
+// the path rows at node z from d loaded with z (go_gait_load_node or node_inverse)
+static int path_rows(const go_gait* g, mjData* d, const double* z, double* res) {
   const go_gait_layout* L = &g->L;
   const mjModel* m = g->m;
   int nv = L->nv;
-  go_gait_load_node(g, d, z);
   // link rows
   for (int j = 0; j < nv; j++) {
     res[L->r_link + j] = z[L->x_qd + j] - z[L->xd_q + j];
@@ -239,9 +279,15 @@ int go_gait_path_eval(const go_gait* g, mjData* d, const double* z, double* res)
   return 0;
 }
 
+int go_gait_path_eval(const go_gait* g, mjData* d, const double* z, double* res) {
+  go_gait_load_node(g, d, z);
+  return path_rows(g, d, z, res);
+}
+
 static int path_cb(void* vctx, int k, const double* z, double* res) {
   gait_ctx* c = (gait_ctx*)vctx;
-  return go_gait_path_eval(c->g, c->d, z, res);
+  node_inverse(c, z);
+  return path_rows(c->g, c->d, z, res);
 }
 
 // analytic columns: q', qddot, a, fT, adot, fT', e, grf
@@ -251,7 +297,7 @@ static int path_jac_cb(void* vctx, int k, const double* z, double* vals) {
   const go_gait_layout* L = &g->L;
   int nv = L->nv;
   mjData* d = c->d;
-  go_gait_load_node(g, d, z);
+  node_inverse(c, z);
   mj_fullM(g->m, c->M, d->qM);
   for (int col = 0; col < L->nz; col++) {
     if (!g->analytic[col]) {
@@ -389,6 +435,7 @@ static double metabolic(const go_gait* g, gait_ctx* c, const double* z, double* 
   mjData* d = c->d;
   int na = L->na, nv = L->nv, nz = L->nz;
   double* P = c->P;
+  forget_position(c);
   muscle_powers(g, d, z, 1, P);
   double val = g->cot_scale * sum(P, na);
   if (!dL) return val;
@@ -709,6 +756,7 @@ void go_gait_free(go_gait* g) {
     if (g->ctx[w].d) mj_deleteData(g->ctx[w].d);
     free(g->ctx[w].M), free(g->ctx[w].P), free(g->ctx[w].Pm), free(g->ctx[w].zp);
     free(g->ctx[w].mus), free(g->ctx[w].mom), free(g->ctx[w].dmom);
+    free(g->ctx[w].pos_q);
   }
   free(g->ctx);
   free(g->ctx_ptr);
@@ -845,6 +893,7 @@ double go_gait_cot(const go_gait* g, const double* z) {
   if (L->tx < 0) return NAN;
   double T = go_gait_time_of(g, z), h = T / (g->N - 1), E = 0;
   gait_ctx* c = &g->ctx[0];
+  forget_position(c);
   for (int k = 0; k < g->N; k++) {
     muscle_powers(g, c->d, z + (size_t)k * L->nz, 1, c->P);
     E += (k == 0 || k == g->N - 1 ? 0.5 : 1.0) * h * sum(c->P, L->na);
@@ -1383,9 +1432,10 @@ static int setup_workers(go_gait* g, char* err, int errsz) {
     g->ctx[w].mus = (double*)zalloc((size_t)4 * na, sizeof(double));
     g->ctx[w].mom = (double*)zalloc((size_t)na * nv, sizeof(double));
     g->ctx[w].dmom = (double*)zalloc((size_t)na * nv, sizeof(double));
+    g->ctx[w].pos_q = (double*)zalloc((size_t)nv, sizeof(double));
     g->ctx_ptr[w] = &g->ctx[w];
     if (!g->ctx[w].d || !g->ctx[w].M || !g->ctx[w].P || !g->ctx[w].Pm || !g->ctx[w].zp ||
-        !g->ctx[w].mus || !g->ctx[w].mom || !g->ctx[w].dmom)
+        !g->ctx[w].mus || !g->ctx[w].mom || !g->ctx[w].dmom || !g->ctx[w].pos_q)
       return out_of_memory(err, errsz, "workers");
   }
   return 0;

@@ -236,4 +236,10 @@ void go_gait_load_node(const go_gait* g, mjData* d, const double* z_k);
 // is not finite.
 int go_gait_path_eval(const go_gait* g, mjData* d, const double* z_k, double* res);
 
+// Evaluations of the path rows or their analytic columns, summed over the workers since
+// go_gait_create, that reused the worker's position stage (MuJoCo's kinematics, tendon paths,
+// moment arms and mass matrix) because the node's coordinates were bitwise those of the previous
+// evaluation: finite differences in anything but q
+long go_gait_position_reuses(const go_gait* g);
+
 #endif  // GAITSIM_OPTIM_GO_GAIT_H_

@@ -466,14 +466,22 @@ int go_hess_create_fd(go_hess** out, go_nlp* nlp, const go_elements* el, char* e
     if (in) f->fvar[f->nf++] = j;
   }
   for (int j = 0; j < nz; j++) mark[(size_t)j * nz + j] = 1;
-  // (A) diagonal rows and pairs
+  // (A) diagonal rows
   for (int a = 0; a < f->nf && !rc; a++) {
     int i = f->fvar[a];
     rc |= ipush(&bptr, drow.n);
     for (int r = 0; r < np; r++)
       if (row_elem[r] >= 0 && HAS(row_elem[r], i)) rc |= ipush(&drow, r);
-    for (int b = 0; b < a; b++) {
-      int j = f->fvar[b];
+  }
+  // ... and pairs (a, b), a > b, with b the outer loop: the pairs that share their lower
+  // variable come one after the other. For the gait problem, whose variables start with the
+  // coordinates, the pairs of a coordinate with each speed then share their coordinates, and its
+  // path evaluation reuses MuJoCo's position stage between them (go_gait.c, node_inverse); each
+  // entry is still written once, so the order changes no value
+  for (int b = 0; b < f->nf && !rc; b++) {
+    int j = f->fvar[b];
+    for (int a = b + 1; a < f->nf && !rc; a++) {
+      int i = f->fvar[a];
       if (el->fd_pairs && !el->fd_pairs[(size_t)i * nz + j] && !el->fd_pairs[(size_t)j * nz + i])
         continue;
       int start = prow.n;

@@ -87,6 +87,8 @@ int go_hess_values(go_hess* h, const double* x, double obj_factor, const double*
 //       of path_jac, the variables perturbed together in colour groups such that within any
 //       element a group holds at most one (distance-1 colouring of "share an element where one
 //       of them is not lin"); entries between two such variables averaged over both perturbations.
+// The pairs are evaluated with their lower variable in the outer loop, so that consecutive
+// evaluations share all but one perturbed variable (a problem may reuse work between them).
 // Costs per node and Hessian: 1 + 2 n_fd + n_pairs path evaluations, 1 + n_fd + 2 n_colours
 // path_jac calls (full body: 26 dofs -> n_fd 52; see docs/BENCHMARKS.md). The pattern holds only
 // the entries these produce (structural zeros of lin x lin left out) and every diagonal. The

@@ -225,12 +225,45 @@ int main(void) {
   EXPECT_EQ_INT(0, go_nlp_eval_g(a, zs, g));
   double t_g = now() - t0;
   go_nlp_reset_counts(a);
+  long reused0 = go_gait_position_reuses(g1);
   t0 = now();
   EXPECT_EQ_INT(0, go_nlp_eval_jac(a, zs, J));
   double t_j = now() - t0;
   go_eval_counts cnt;
   go_nlp_counts(a, &cnt);
   EXPECT_EQ_INT(2L * 2 * L->nv * 4, cnt.path_evals_last_jac);
+  // the position stage reused: per node, the analytic columns and the 2 nv evaluations of the q
+  // colour groups compute it, the first qdot group's + evaluation computes it again at the
+  // node's own q, and its - evaluation and the other nv - 1 qdot groups' 2 (nv - 1) reuse it
+  long reused_jac = go_gait_position_reuses(g1) - reused0;
+  EXPECT_EQ_INT(4L * (2 * L->nv - 1), reused_jac);
+  // ... and gives the path rows bitwise: node 1's rows with node 0 at node 1's coordinates (node
+  // 1 reuses node 0's stage) equal those with node 0 elsewhere (node 1 computes its own)
+  {
+    double* zA = malloc(sizeof(double) * (size_t)n);
+    double* zsA = malloc(sizeof(double) * (size_t)n);
+    double* gA = malloc(sizeof(double) * (size_t)mm);
+    double* gB = malloc(sizeof(double) * (size_t)mm);
+    memcpy(zA, z, sizeof(double) * (size_t)n);
+    memcpy(zA + L->x_q, z + L->nz + L->x_q, sizeof(double) * (size_t)L->nv);
+    go_nlp_scale_z(a, zA, zsA);
+    long r0 = go_gait_position_reuses(g1);
+    EXPECT_EQ_INT(0, go_nlp_eval_g(a, zsA, gA));
+    long hitA = go_gait_position_reuses(g1) - r0;
+    zA[L->x_q + 2] += 1e-3;  // node 0 a millimetre higher
+    go_nlp_scale_z(a, zA, zsA);
+    r0 = go_gait_position_reuses(g1);
+    EXPECT_EQ_INT(0, go_nlp_eval_g(a, zsA, gB));
+    long hitB = go_gait_position_reuses(g1) - r0;
+    EXPECT_TRUE(hitA >= 1);
+    EXPECT_EQ_INT(0, hitB);
+    int r1 = go_nlp_row_path(a, 1, 0);
+    EXPECT_EQ_INT(0, memcmp(gA + r1, gB + r1, sizeof(double) * (size_t)L->n_path));
+    printf("position stage reused by %ld of %ld Jacobian path evaluations; node 1's rows "
+           "bitwise equal with and without reuse: %s\n", reused_jac, cnt.path_evals_last_jac,
+           memcmp(gA + r1, gB + r1, sizeof(double) * (size_t)L->n_path) == 0 ? "yes" : "no");
+    free(zA), free(zsA), free(gA), free(gB);
+  }
   printf("per-node path evaluation %.1f us; Jacobian (N=4, 1 thread) %.2f ms, %ld path evals + %ld "
          "analytic calls\n", 1e6 * t_g / 4, 1e3 * t_j, cnt.path_evals_last_jac, cnt.path_jac_calls);
   EXPECT_EQ_INT(0, go_nlp_eval_f(a, zs, &f));

@@ -90,13 +90,19 @@ int main(void) {
   double* hv2 = malloc(sizeof(double) * (size_t)nh);
   go_hess_structure(h1, hr, hc);
   EXPECT_EQ_INT(nh, go_hess_nnz(h2));
+  long reused0 = go_gait_position_reuses(g1);
   EXPECT_EQ_INT(0, go_hess_values(h1, zs, 0.0, lam, hv));
+  long reused = go_gait_position_reuses(g1) - reused0;
   EXPECT_EQ_INT(0, go_hess_values(h2, zs, 0.0, lam, hv2));
   EXPECT_TRUE(memcmp(hv, hv2, sizeof(double) * (size_t)nh) == 0);
   go_eval_counts c;
   go_nlp_counts(nlp, &c);
   printf("fd Hessian: %d entries per node (nz %d), %ld path evaluations and %ld path_jac calls "
-         "for 2 nodes\n", nh / 2, nz, c.path_evals, c.path_jac_calls);
+         "for 2 nodes, %ld of them on the position stage of the one before\n", nh / 2, nz,
+         c.path_evals, c.path_jac_calls, reused);
+  // every evaluation at the node's own coordinates but the first, and every pair of a speed with
+  // a coordinate but the first of each coordinate, reuses the position stage: over half of all
+  EXPECT_TRUE(2 * reused > c.path_evals + c.path_jac_calls);
 
   // dense node-0 block of the FD Hessian (symmetric) and its pattern
   double* H = calloc((size_t)nz * nz, sizeof(double));

@@ -25,8 +25,8 @@ static const char* kRunUsage =
     "six-DOF implant knee with surrogate contact, and mjmodels/trials/jw_ngait_og5, or the\n"
     "trial folder of --trial, e.g. mjmodels/trials/jw_bouncy7):\n"
     "  1. DIR/track: tracking solve on N nodes (default " GO_STR(GO_NODES_MAIN_JOB)
-    "; more nodes are solved on " GO_STR(GO_NODES_MAIN_JOB) " first and\n"
-    "     continued): up to " GO_STR(GO_MAX_ITER_MAIN_TRACK) " L-BFGS iterations; if they stop "
+    ", the paper's resolution) from the trial,\n"
+    "     as gaitsim track: up to " GO_STR(GO_MAX_ITER_TRACK) " L-BFGS iterations; if they stop "
     "short, " GO_STR(GO_REFINE_GN_ITER) " Gauss-Newton\n"
     "     iterations, then up to " GO_STR(GO_REFINE_ITER) " Newton iterations with the exact "
     "Hessian until the objective\n"
@@ -46,12 +46,15 @@ static const char* kRunUsage =
     "  --max-iter N   Ipopt iteration limit of each predictive solve (default "
     GO_STR(GO_MAX_ITER_SWEEP) ": an iteration\n"
     "                 budget, not a time limit, so that the results do not depend on the load\n"
-    "                 of the machine; in the measured main job (docs/BENCHMARKS.md) they\n"
-    "                 reached Ipopt's acceptable level after 421 (0.8 m/s) and 396 (2.0 m/s)\n"
-    "                 iterations, about 3 minutes each side by side on 2 cores)\n"
-    "  --max-time S   wall-clock limit of each predictive solve, s (default none); the tracking\n"
-    "                 solve stops after " GO_STR(GO_MAX_ITER_MAIN_TRACK) " iterations ("
-    GO_STR(GO_MAX_ITER_MAIN_CONTINUED) " on a continued mesh)\n";
+    "                 of the machine; at 80 nodes the predictions at 0.8 and 2.0 m/s reached\n"
+    "                 Ipopt's acceptable level after 767 iterations each, docs/BENCHMARKS.md)\n"
+    "  --nodes N      collocation nodes of every solve (default " GO_STR(GO_NODES_MAIN_JOB)
+    "; 20 gives a coarse\n"
+    "                 look in minutes)\n"
+    "  --threads N    worker threads of the tracking solve (default " GO_STR(GO_THREADS)
+    "; each prediction runs\n"
+    "                 on one, in its own process)\n"
+    "  --max-time S   wall-clock limit of each predictive solve, s (default none)\n";
 
 // run one subcommand with the given words (argv[0] is the subcommand)
 static int sub(gsCommandFn fn, const char* const* words) {
@@ -143,11 +146,8 @@ int gs_cmd_run(int argc, char** argv) {
   // sweep.csv) or absent; each is written whole by its step (track, sweep), so a failed or
   // interrupted run leaves the steps that finished and no half-written folder
   char err[1024], sub_dir[4200];
-  static const char* const kSteps[3][2] = {
-      {"track", "summary.json"},
-      {"track_n" GO_STR(GO_NODES_MAIN_JOB), "summary.json"},
-      {"sweep", "sweep.csv"}};
-  for (int i = 0; i < 3; i++) {
+  static const char* const kSteps[2][2] = {{"track", "summary.json"}, {"sweep", "sweep.csv"}};
+  for (int i = 0; i < 2; i++) {
     snprintf(sub_dir, sizeof(sub_dir), "%s/%s", out, kSteps[i][0]);
     if (gs_folder_replaceable(sub_dir, kSteps[i][1], err, sizeof(err)) != 0) {
       fprintf(stderr, "gaitsim: %s\n", err);
@@ -155,31 +155,18 @@ int gs_cmd_run(int argc, char** argv) {
     }
   }
   go_ipopt_install_stop_signals(gs_folder_abort_from_signal);
-  char coarse[4096], track[4096];
-  snprintf(coarse, sizeof(coarse), "%s/track_n" GO_STR(GO_NODES_MAIN_JOB), out);
+  char track[4096];
   snprintf(track, sizeof(track), "%s/track", out);
   int stopped_short = 0, rc;
 
-  // 1. tracking (GO_NODES_MAIN_JOB nodes first when more are asked for)
-  const char* main_nodes = GO_STR(GO_NODES_MAIN_JOB);
-  int continued = strcmp(nodes, main_nodes) != 0;
-  printf("[1] tracking solve of %s, %s nodes -> %s\n", trial, continued ? main_nodes : nodes,
-         continued ? coarse : track);
-  const char* w1[] = {"track", trial, "--out", continued ? coarse : track, "--nodes", main_nodes,
-                      "--threads", threads, "--max-iter", GO_STR(GO_MAX_ITER_MAIN_TRACK), NULL};
+  // 1. tracking, as gaitsim track on the asked mesh
+  printf("[1] tracking solve of %s, %s nodes -> %s\n", trial, nodes, track);
+  const char* w1[] = {"track", trial, "--out", track, "--nodes", nodes, "--threads", threads,
+                      NULL};
   rc = sub(gs_cmd_track, w1);
   if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
   stopped_short |= rc == GS_EXIT_STOPPED_SHORT;
   if (stopped_by_signal(out)) return GS_EXIT_STOPPED_SHORT;
-  if (continued) {
-    printf("[1] tracking solve, %s nodes, started from it -> %s\n", nodes, track);
-    const char* w2[] = {"track", trial, "--out", track, "--nodes", nodes, "--threads", threads,
-                        "--init", coarse, "--max-iter", GO_STR(GO_MAX_ITER_MAIN_CONTINUED), NULL};
-    rc = sub(gs_cmd_track, w2);
-    if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
-    stopped_short |= rc == GS_EXIT_STOPPED_SHORT;
-    if (stopped_by_signal(out)) return GS_EXIT_STOPPED_SHORT;
-  }
 
   // 2. predictions (gaitsim sweep): each speed from the nearest one solved, for the default
   // speeds the tracking solution
@@ -188,7 +175,7 @@ int gs_cmd_run(int argc, char** argv) {
   printf("[2] predictive solves at %s m/s from the tracking solution -> %s\n",
          speeds, sweep_dir);
   const char* w3[] = {"sweep", "--guess", track, "--speeds", speeds, "--out", sweep_dir,
-                      "--nodes", continued ? nodes : main_nodes, "--max-iter", max_iter,
+                      "--nodes", nodes, "--max-iter", max_iter,
                       max_time ? "--max-time" : NULL, max_time, NULL};
   rc = sub(gs_cmd_sweep, w3);
   if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;

@@ -13,10 +13,7 @@
                               // (Lin, Walter & Pandy 2018)
 #define GO_NODES_PREDICT 20   // gaitsim predict and sweep when the guess's summary.json gives no
                               // node count (else they solve on the guess's mesh)
-#define GO_NODES_MAIN_JOB 20  // gaitsim run's main job (its tracking solve, then its sweep): the
-                              // main job's resolution until 80-node solves converge in its time
-                              // budget (issue #19); more nodes are solved on this many first and
-                              // continued
+#define GO_NODES_MAIN_JOB 80  // gaitsim run's main job (its tracking solve, then its sweep)
 // worker threads of one solve (-)
 #define GO_THREADS 2
 // Ipopt iteration limits (-)
@@ -33,11 +30,6 @@
 #define GO_MAX_ITER_SWEEP 1500     // each prediction of sweep and of run's main job: an
                                    // iteration budget, not a time limit, so results do not
                                    // depend on the load of the machine
-#define GO_MAX_ITER_MAIN_TRACK 200     // run's tracking solve on GO_NODES_MAIN_JOB nodes, before
-                                       // the refinement (Gauss-Newton, then Newton): 200 L-BFGS
-                                       // iterations then settled at J 2.6107 where 600 reached
-                                       // the acceptable level at 2.6122, in less time
-#define GO_MAX_ITER_MAIN_CONTINUED 1000  // run's tracking solve continued on more nodes
 // initial activations and excitations of a guess from the trial or a solution's states (-)
 #define GO_ACTIVATION 0.05
 // fall-back guard (go_ipopt_opts.fallback_rise, fallback_viol): stop when the objective rises by

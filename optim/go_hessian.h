@@ -97,7 +97,8 @@ int go_hess_values(go_hess* h, const double* x, double obj_factor, const double*
 // Rows in no element are taken as linear. Same arguments and results as go_hess_create.
 // Measured (docs/BENCHMARKS.md, "Resolution"): 8468 Hessian entries per node of jw_fullbody and
 // about 910 path evaluations per node and Hessian (tests/test_hessian_fd.c prints both); at N = 80
-// about 3.4 s of CPU per Hessian. From the trial's guess with Ipopt's monotone barrier from mu 0.1
+// about 3.4 s of CPU per Hessian on one core (5.9 s before go_gait reused its position stage,
+// "The position stage reused"). From the trial's guess with Ipopt's monotone barrier from mu 0.1
 // the steps are tiny (alpha 1e-3 - 1e-1) and inf_du grows to 1e5-1e9 within 30 iterations (the
 // values are right: tests/test_hessian_fd.c); from an L-BFGS tracking solution with mu 1e-6 and
 // mu-based bound multipliers it reaches Ipopt's acceptable level in about 50 iterations at N = 20,

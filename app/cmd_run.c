@@ -46,8 +46,9 @@ static const char* kRunUsage =
     "  --max-iter N   Ipopt iteration limit of each predictive solve (default "
     GO_STR(GO_MAX_ITER_SWEEP) ": an iteration\n"
     "                 budget, not a time limit, so that the results do not depend on the load\n"
-    "                 of the machine; at 80 nodes the predictions at 0.8 and 2.0 m/s reached\n"
-    "                 Ipopt's acceptable level after 767 iterations each, docs/BENCHMARKS.md)\n"
+    "                 of the machine; in the measured main job (docs/BENCHMARKS.md) they\n"
+    "                 reached Ipopt's acceptable level after 1450 (0.8 m/s) and 811 (2.0 m/s)\n"
+    "                 iterations, about 27 minutes side by side on 2 cores)\n"
     "  --nodes N      collocation nodes of every solve (default " GO_STR(GO_NODES_MAIN_JOB)
     "; 20 gives a coarse\n"
     "                 look in minutes)\n"

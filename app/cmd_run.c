@@ -44,7 +44,7 @@ static const char* kRunUsage =
     "  --trial DIR    the trial folder to track (coordinates.mot, grf.mot, knee_contact.sto;\n"
     "                 scripts/prepare_trial.py makes one; default mjmodels/trials/jw_ngait_og5)\n"
     "  --max-iter N   Ipopt iteration limit of each predictive solve (default "
-    GO_STR(GO_MAX_ITER_SWEEP) ": an iteration\n"
+    GO_STR(GO_MAX_ITER) ": an iteration\n"
     "                 budget, not a time limit, so that the results do not depend on the load\n"
     "                 of the machine; in the measured main job (docs/BENCHMARKS.md) they\n"
     "                 reached Ipopt's acceptable level after 1450 (0.8 m/s) and 811 (2.0 m/s)\n"
@@ -99,7 +99,7 @@ int gs_cmd_run(int argc, char** argv) {
       {"trial", required_argument, NULL, 'r'},    {"help", no_argument, NULL, 'h'},
       {NULL, 0, NULL, 0}};
   const char *out = "results", *nodes = GO_STR(GO_NODES_MAIN_JOB), *max_time = NULL;
-  const char *threads = GO_STR(GO_THREADS), *max_iter = GO_STR(GO_MAX_ITER_SWEEP);
+  const char *threads = GO_STR(GO_THREADS), *max_iter = GO_STR(GO_MAX_ITER);
   char speeds[256] = "0.8,2.0";
   int video = 1;
   const char* trial = GAITSIM_SOURCE_DIR "/mjmodels/trials/jw_ngait_og5";

@@ -41,7 +41,7 @@ static const char* kSweepUsage =
     "  --nodes N       collocation nodes (default: the guess's, as gaitsim predict)\n"
     "  --max-time S    wall-clock limit of each solve, s (default none: the iteration limit,\n"
     "                  so that the results do not depend on the load of the machine)\n"
-    "  --max-iter N    Ipopt iteration limit of each solve (default " GO_STR(GO_MAX_ITER_SWEEP)
+    "  --max-iter N    Ipopt iteration limit of each solve (default " GO_STR(GO_MAX_ITER)
     ")\n";
 
 // the guess's mean speed (summary.json speed_mps), or NAN
@@ -148,7 +148,7 @@ int gs_cmd_sweep(int argc, char** argv) {
       {"help", no_argument, NULL, 'h'},
       {NULL, 0, NULL, 0}};
   const char *guess = NULL, *dir = NULL, *nodes = NULL, *max_time = NULL;
-  const char* max_iter = GO_STR(GO_MAX_ITER_SWEEP);
+  const char* max_iter = GO_STR(GO_MAX_ITER);
   double v[SWEEP_MAX_SPEEDS];
   int n = -1, c, bad = 0;
   optind = 1;

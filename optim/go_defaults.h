@@ -17,7 +17,12 @@
 // worker threads of one solve (-)
 #define GO_THREADS 2
 // Ipopt iteration limits (-)
-#define GO_MAX_ITER 2500           // predict (--max-iter): as sweep's (below)
+#define GO_MAX_ITER 2500           // each prediction: gaitsim predict, each speed of sweep and of
+                                   // run's main job (--max-iter). An iteration budget, not a time
+                                   // limit, so results do not depend on the load of the machine;
+                                   // at 80 nodes the main job's 0.8 m/s prediction reached
+                                   // Ipopt's acceptable level after 1450 iterations, its 2.0 m/s
+                                   // one after 811
 #define GO_MAX_ITER_TRACK 300      // track's L-BFGS solve, before the refinement (--max-iter)
 #define GO_HANDOVER_ITER_TRACK 0   // ... and with --refine-after N > 0 hands over to the
                                    // refinement at its first iterate from iteration N on at a
@@ -27,11 +32,6 @@
                                    // 150-iteration cap was 4 minutes faster there but left
                                    // jw_bouncy7 without a usable start (docs/BENCHMARKS.md, "A
                                    // shorter L-BFGS phase")
-#define GO_MAX_ITER_SWEEP 2500     // each prediction of sweep and of run's main job: an
-                                   // iteration budget, not a time limit, so results do not
-                                   // depend on the load of the machine; at 80 nodes the main
-                                   // job's 0.8 m/s prediction reached Ipopt's acceptable level
-                                   // after 1450 iterations, its 2.0 m/s one after 811
 // initial activations and excitations of a guess from the trial or a solution's states (-)
 #define GO_ACTIVATION 0.05
 // fall-back guard (go_ipopt_opts.fallback_rise, fallback_viol): stop when the objective rises by

@@ -158,7 +158,8 @@ void go_gait_load_node(const go_gait* g, mjData* d, const double* z) {
 // so mj_inverseSkip(mjSTAGE_POS) then gives the same numbers as mj_inverse, bitwise
 // (tests/test_gait_problem.c checks it). Finite differences in the speeds, activations,
 // excitations and tendon forces of one node hit it: about half the path evaluations of a
-// Jacobian and of an exact Hessian (docs/BENCHMARKS.md, "The position stage reused").
+// Jacobian, over two thirds of an exact Hessian's (docs/BENCHMARKS.md, "The position stage
+// reused").
 static void node_inverse(gait_ctx* c, const double* z) {
   const go_gait* g = c->g;
   mjData* d = c->d;

@@ -8,8 +8,9 @@
 # (both phases), gauss_newton {iterations 4, objective and violation of its last point}, used
 # true}, the progress says so, "iterations" counts all solves (17), and wall_s the whole solve:
 # at least the solves' ipopt_wall_s and the polish's wall time together. --refine 0 runs no refinement (no refine object); --refine with
-# a negative count is a usage error (exit 2). --refine-time 0.5 stops a refinement by its wall
-# clock before its 10 Newton iterations (each takes about 2 s).
+# a negative count is a usage error (exit 2). --refine-time 0.2 stops a refinement by its wall
+# clock before its 10 Newton iterations (at 5 nodes each takes about 0.05-0.07 s on a quiet core:
+# 0.2 s holds about 3, where 0.5 s held up to all 10).
 # usage: refine.sh GAITSIM SOURCE_DIR
 set -u
 gaitsim=$1 src=$2
@@ -46,9 +47,9 @@ PY
 check "--refine 0: no refine object" /usr/bin/python3 -c \
   'import json,sys; sys.exit("refine" in json.load(open("tr0/summary.json")))'
 "$gaitsim" track "$src/mjmodels/trials/jw_ngait_og5" --init "$src/tests/fixtures/solution_small" \
-  --out trt --nodes 5 --max-iter 1 --refine 10 --refine-time 0.5 --threads 1 --no-polish \
+  --out trt --nodes 5 --max-iter 1 --refine 10 --refine-time 0.2 --threads 1 --no-polish \
   >/dev/null 2>&1
-check "--refine-time 0.5: the refinement stops on its wall clock before 10 iterations" \
+check "--refine-time 0.2: the refinement stops on its wall clock before 10 iterations" \
   /usr/bin/python3 -c 'import json,sys; r=json.load(open("trt/summary.json"))["refine"]
 sys.exit(not (r["status"] == "wall-time limit reached" and r["iterations"] < 10))'
 "$gaitsim" track "$src/mjmodels/trials/jw_ngait_og5" --out x --refine -1 >/dev/null 2>&1

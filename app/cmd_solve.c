@@ -46,8 +46,9 @@ static const char* kTrackUsage =
     "                      kept), else its states.sto and controls.sto interpolated (default:\n"
     "                      the trial)\n"
     "  --threads N         worker threads (default " GO_STR(GO_THREADS) ")\n"
-    "  --max-iter N        Ipopt iteration limit of the main (L-BFGS) solve (default "
-    GO_STR(GO_MAX_ITER_TRACK) ")\n"
+    "  --max-iter N        Ipopt iteration limit of the main solve (default "
+    GO_STR(GO_MAX_ITER_TRACK) "; 300 with\n"
+    "                      --hessian lbfgs)\n"
     "  --max-time S        wall-clock limit, s (default none)\n"
     "  --activation A      initial activations and excitations (default " GO_STR(GO_ACTIVATION)
     ")\n"
@@ -57,10 +58,12 @@ static const char* kTrackUsage =
     "                      forces matching the inverse-dynamics moments of every dof but the\n"
     "                      pelvis and the spring-held knee dofs, measured GRF at the measured\n"
     "                      centres of pressure; tendon forces from the muscle forces)\n"
-    "  --hessian H         lbfgs (default: Ipopt's limited-memory quasi-Newton), pqn\n"
-    "                      (partitioned quasi-Newton, SR1 per node element; experimental),\n"
-    "                      gauss-newton (exact for the tracking squares, constraints left out)\n"
-    "                      or exact (the Lagrangian's Hessian by structured finite differences)\n"
+    "  --hessian H         Hessian of the main solve: gauss-newton (default: exact for the\n"
+    "                      tracking squares, the constraints' curvature left out; from an\n"
+    "                      initial barrier of " GO_STR(GO_GN_MU_INIT) "), lbfgs (Ipopt's limited-memory\n"
+    "                      quasi-Newton), pqn (partitioned quasi-Newton, SR1 per node element;\n"
+    "                      experimental) or exact (the Lagrangian's Hessian by structured\n"
+    "                      finite differences)\n"
     "  --weight NAME=W     goal weight, NAME one of pelvis_rot (default "
     GO_STR(GO_TRACK_W_PELVIS_ROT) "), pelvis_trans (" GO_STR(GO_TRACK_W_PELVIS_TRANS) "),\n"
     "                      joint (" GO_STR(GO_TRACK_W_JOINT) "), grf (" GO_STR(GO_TRACK_W_GRF)
@@ -84,7 +87,8 @@ static const char* kTrackUsageSolver =
     "                      best iterate (at most " GO_STR(GO_MAX_RESTARTS) " times; summary.json "
     "restarts); default " GO_STR(GO_FALLBACK_RISE) ",\n"
     "                      0 turns the guard off\n"
-    "  --refine N          after an L-BFGS solve that stopped short, up to N Newton\n"
+    "  --refine N          after a Gauss-Newton or L-BFGS main solve that stopped short (as\n"
+    "                      the default one does after --max-iter iterations), up to N Newton\n"
     "                      iterations with the exact Hessian (structured finite differences)\n"
     "                      from its best iterate (default " GO_STR(GO_REFINE_ITER) ", at most "
     GO_STR(GO_REFINE_WALL_S) " s; 0: none;\n"
@@ -99,7 +103,7 @@ static const char* kTrackUsageSolver =
     "                      where they stop (default "
     GO_STR(GO_REFINE_GN_ITER) ";\n"
     "                      0: none; summary.json refine.gauss_newton)\n"
-    "  --refine-after N    the L-BFGS solve hands over to the refinement at its first\n"
+    "  --refine-after N    with --hessian lbfgs: hands over to the refinement at its first\n"
     "                      iterate from iteration N on at a violation <= 1e-3 (a point the\n"
     "                      refinement and the polish can start from; status \"handed over to\n"
     "                      the refinement\"), --max-iter staying its cap (default "
@@ -165,6 +169,7 @@ static void defaults(gsTrackOptions* o) {
   o->threads = GO_THREADS;
   o->activation = GO_ACTIVATION;
   go_solve_plan_default(&o->plan);
+  o->plan.hessian = GO_HESSIAN_GAUSS_NEWTON;  // predict: L-BFGS
   o->plan.max_iter = GO_MAX_ITER_TRACK;
   o->plan.handover_iter = GO_HANDOVER_ITER_TRACK;
   o->plan.progress = stderr;
@@ -937,7 +942,9 @@ int gs_cmd_predict(int argc, char** argv) {
   defaults(&o);
   o.predict = 1;
   o.plan.label = "predict";
-  o.plan.refine_iter = 0;  // the exact Hessian leaves out the cost of transport's curvature
+  o.plan.hessian = GO_HESSIAN_LBFGS;
+  o.plan.refine_iter = 0;  // Newton after L-BFGS settles at a higher cost (docs/BENCHMARKS.md,
+                           // "Predictions: the metabolic Hessian and Newton")
   o.plan.max_iter = GO_MAX_ITER;
   o.nodes = GO_NODES_PREDICT;
   o.w_effort = GO_PREDICT_W_EFFORT;

@@ -453,8 +453,8 @@ static int fill_solve(gsBatchPlan* p, const cJSON* root, const cJSON* e, int idx
   // (a prediction without --nodes solves on its guess's mesh: the tracking default bounds it)
   int nodes = arg_int(s, "--nodes", GO_NODES_TRACK);
   // iterations: a prediction's own limit (predict's default GO_MAX_ITER); for a track 1000, within
-  // which its 300 L-BFGS iterations and its refinement (60 Gauss-Newton, up to 150 Newton
-  // iterations at about 3 times an L-BFGS one's cost) stay
+  // which its 60 Gauss-Newton iterations and its refinement (60 Gauss-Newton, up to 150 Newton
+  // iterations at about 6 times a Gauss-Newton one's cost) stay
   int iter = arg_int(s, "--max-iter", s->speed > 0 ? GO_MAX_ITER : 1000);
   s->time_min = 10 + (int)(0.05 * nodes * iter / 60);
   s->mem_mb = 1024 + 20 * nodes;

@@ -49,6 +49,14 @@ typedef int (*go_integrand_grad_fn)(void* ctx, int k, const double* z_k, double*
 // enables the Gauss-Newton Hessian (go_nlp_eval_hess_diag)
 typedef int (*go_integrand_hess_fn)(void* ctx, int k, const double* z_k, double* d2L);
 
+// the integrand's whole Hessian at node k: H (nz x nz, dense, row-major, symmetric: both
+// triangles written), every entry outside integrand_hess_mask 0. For an integrand with mixed
+// curvature (e.g. the metabolic power, whose muscle terms couple a muscle's excitation,
+// activation and tendon force with the coordinates and speeds it crosses); the exact
+// finite-difference Hessian (go_hessian.h, go_hess_create_fd) then uses it in place of the
+// diagonal
+typedef int (*go_integrand_hess_block_fn)(void* ctx, int k, const double* z_k, double* H);
+
 // boundary constraints b (n_boundary) from the first and last node variables and T
 typedef int (*go_boundary_fn)(void* ctx, const double* z_first, const double* z_last, double T,
                               double* b);
@@ -113,6 +121,8 @@ typedef struct {
   int n_integrand_vars;
   go_integrand_grad_fn integrand_grad;   // optional analytic gradient (else central differences)
   go_integrand_hess_fn integrand_hess;   // optional diagonal Hessian (Gauss-Newton Hessian)
+  go_integrand_hess_block_fn integrand_hess_block;  // optional whole node Hessian (exact Hessian)
+  const unsigned char* integrand_hess_mask;  // nz x nz: its possible nonzeros (required with it)
   go_outer_fn outer;                     // optional, NULL: J = I
 
   // boundary constraints

@@ -23,10 +23,21 @@
                                    // at 80 nodes the main job's 0.8 m/s prediction reached
                                    // Ipopt's acceptable level after 1450 iterations, its 2.0 m/s
                                    // one after 811
-#define GO_MAX_ITER_TRACK 300      // track's L-BFGS solve, before the refinement (--max-iter)
-#define GO_HANDOVER_ITER_TRACK 0   // ... and with --refine-after N > 0 hands over to the
-                                   // refinement at its first iterate from iteration N on at a
-                                   // violation <= 1e-3. Off: on jw_ngait_og5 at N = 80, N = 150
+#define GO_MAX_ITER_TRACK 60       // track's main solve, Gauss-Newton from the trial's guess at
+                                   // barrier GO_GN_MU_INIT, before the refinement (--max-iter).
+                                   // At N = 80 it brings the violation from 182 to about 0.1 at
+                                   // J 3.5, where the refinement's Gauss-Newton and Newton
+                                   // phases take over; 300 L-BFGS iterations did the same job in
+                                   // 11 minutes (docs/BENCHMARKS.md, "Gauss-Newton from the
+                                   // trial")
+#define GO_GN_MU_INIT 1e-4         // a Gauss-Newton main solve's initial barrier (Ipopt's
+                                   // mu_init, -): from Ipopt's 0.1 the Gauss-Newton steps stay
+                                   // tiny (J 54 after 300 iterations at N = 20); from 1e-4 they
+                                   // are full within 40
+#define GO_HANDOVER_ITER_TRACK 0   // with --hessian lbfgs and --refine-after N > 0, L-BFGS
+                                   // hands over to the refinement at its first iterate from
+                                   // iteration N on at a violation <= 1e-3. Off: on
+                                   // jw_ngait_og5 at N = 80 (300 L-BFGS iterations), N = 150
                                    // handed over at iteration 230 and the whole solve took as
                                    // long (1097 s against 1140 s, J 2.649 against 2.641); a flat
                                    // 150-iteration cap was 4 minutes faster there but left

@@ -40,6 +40,8 @@ typedef struct {
   double* mom;        // actuator moment arms at the node (na x nv, m or m/rad)
   double* dmom;       // their derivative along qdot (na x nv, m/s or m/(rad s))
   double* pos_q;      // the coordinates d's position stage was computed at (nv, m or rad)
+  double* hz;         // the metabolic Hessian's perturbed node variables and the gradients at
+                      // z +- h e_j (3 nz; integrand_hess_block_cb)
   int pos_valid;      // 1: d's position stage is that of pos_q (see node_inverse)
   long pos_reused;    // node_inverse calls that reused it
 } gait_ctx;
@@ -95,6 +97,7 @@ struct go_gait {
   int* el_mem;                // their arrays, one allocation
   unsigned char* el_lin;      // per element variable: 1 where the element is linear (go_elements)
   unsigned char* el_pairs;    // nz x nz: q/qdot pairs with possible mixed curvature (go_elements)
+  unsigned char* obj_mask;    // nz x nz: the integrand's possible Hessian entries (prediction)
   gait_ctx* ctx;              // (nthreads)
   void** ctx_ptr;             // (nthreads)
   int nthreads;
@@ -595,6 +598,91 @@ static int integrand_hess_cb(void* vctx, int k, const double* z, double* d2L) {
   return 0;
 }
 
+// The integrand's whole Hessian at node k (go_integrand_hess_block_fn): the squares' diagonal
+// (integrand_hess_cb) plus the metabolic power's Hessian, by central differences of its
+// chain-rule gradient (metabolic) with a step of 1e-4 max(1, |z_j|):
+//   - a column for each coordinate and speed of a dof some muscle crosses (2 gradients each);
+//   - one perturbation of every muscle's activation at once, one of every excitation, one of
+//     every tendon force: muscle i's power reads only its own a_i, e_i and fT_i besides q and
+//     qdot, so the entries among those three of one muscle come out of the same gradients; the
+//     entries between them and q or qdot are read from the q and qdot columns.
+// Entries read from two columns (q and qdot among themselves) are averaged, so H is symmetric.
+// Cost per node: 2 (2 n_crossed + 3) gradients of 14 muscle sweeps and 3 position stages each.
+// a finite-difference step in node variable j: rel times its scale, or |z_j| when larger
+static double step_of(const go_gait* g, const double* z, int j, double rel) {
+  return rel * fmax(g->z_scale[j], fabs(z[j]));
+}
+
+static int integrand_hess_block_cb(void* vctx, int k, const double* z, double* H) {
+  gait_ctx* c = (gait_ctx*)vctx;
+  const go_gait* g = c->g;
+  const go_gait_layout* L = &g->L;
+  int nz = L->nz, nv = L->nv, na = L->na;
+  memset(H, 0, sizeof(double) * (size_t)nz * (size_t)nz);
+  double* diag = c->hz;  // the squares' diagonal first (hz is free until the metabolic part)
+  integrand_hess_cb(vctx, k, z, diag);
+  for (int j = 0; j < nz; j++) H[(size_t)j * nz + j] = diag[j];
+  if (g->prox_z0 || !(g->cot_scale > 0)) return 0;
+  double *zp = c->hz, *gp = c->hz + nz, *gm = c->hz + 2 * nz;
+  const double rel = 1e-4;
+  memcpy(zp, z, sizeof(double) * (size_t)nz);
+  // columns of the coordinates and speeds
+  for (int col = 0; col < 2 * nv; col++) {
+    int j = col < nv ? L->x_q + col : L->x_qd + col - nv, dof = col < nv ? col : col - nv;
+    int crossed = 0;
+    for (int i = 0; i < na && !crossed; i++) crossed = g->cross[i * nv + dof];
+    if (!crossed) continue;
+    double hj = step_of(g, z, j, rel);
+    memset(gp, 0, sizeof(double) * (size_t)nz);
+    memset(gm, 0, sizeof(double) * (size_t)nz);
+    zp[j] = z[j] + hj;
+    metabolic(g, c, zp, gp);
+    zp[j] = z[j] - hj;
+    metabolic(g, c, zp, gm);
+    zp[j] = z[j];
+    for (int r = 0; r < nz; r++) {
+      if (!g->obj_mask[(size_t)r * nz + j]) continue;
+      double v = (gp[r] - gm[r]) / (2 * hj);
+      if (r >= L->x_q && r < L->x_qd + nv) {  // q or qdot: the other column gives it too
+        H[(size_t)r * nz + j] += 0.5 * v;
+        H[(size_t)j * nz + r] += 0.5 * v;
+      } else {
+        H[(size_t)r * nz + j] += v;
+        H[(size_t)j * nz + r] += v;
+      }
+    }
+  }
+  // every muscle's a, e, fT at once: the entries among one muscle's own three
+  const int blocks[3][2] = {{L->x_a, na}, {L->u_e, na}, {L->x_ft, L->ne}};
+  for (int b = 0; b < 3; b++) {
+    int off = blocks[b][0], cnt = blocks[b][1];
+    memset(gp, 0, sizeof(double) * (size_t)nz);
+    memset(gm, 0, sizeof(double) * (size_t)nz);
+    for (int t = 0; t < cnt; t++) zp[off + t] = z[off + t] + step_of(g, z, off + t, rel);
+    metabolic(g, c, zp, gp);
+    for (int t = 0; t < cnt; t++) zp[off + t] = z[off + t] - step_of(g, z, off + t, rel);
+    metabolic(g, c, zp, gm);
+    for (int t = 0; t < cnt; t++) zp[off + t] = z[off + t];
+    for (int t = 0; t < cnt; t++) {
+      int i = b == 2 ? L->elastic[t] : t, j = off + t;
+      double hj = step_of(g, z, j, rel);
+      int own[3] = {L->x_a + i, L->u_e + i, L->elastic_of[i] >= 0 ? L->x_ft + L->elastic_of[i] : -1};
+      for (int o = 0; o < 3; o++) {
+        int r = own[o];
+        if (r < 0 || r < j) continue;  // each pair once, from its lower variable's block
+        double v = (gp[r] - gm[r]) / (2 * hj);
+        if (r == j) {
+          H[(size_t)r * nz + j] += v;
+        } else {
+          H[(size_t)r * nz + j] += v;
+          H[(size_t)j * nz + r] += v;
+        }
+      }
+    }
+  }
+  return 0;
+}
+
 static int outer_cb(void* ctx, double I, double T, double* J, double* dJdI, double* dJdT) {
   *J = I / T;
   *dJdI = 1.0 / T;
@@ -757,7 +845,7 @@ void go_gait_free(go_gait* g) {
     if (g->ctx[w].d) mj_deleteData(g->ctx[w].d);
     free(g->ctx[w].M), free(g->ctx[w].P), free(g->ctx[w].Pm), free(g->ctx[w].zp);
     free(g->ctx[w].mus), free(g->ctx[w].mom), free(g->ctx[w].dmom);
-    free(g->ctx[w].pos_q);
+    free(g->ctx[w].pos_q), free(g->ctx[w].hz);
   }
   free(g->ctx);
   free(g->ctx_ptr);
@@ -767,7 +855,7 @@ void go_gait_free(go_gait* g) {
   free(g->z_lb), free(g->z_ub), free(g->z_scale), free(g->path_scale), free(g->bnd_var);
   free(g->bnd_col_ptr), free(g->bnd_row_idx), free(g->bnd_scale), free(g->q_ref);
   free(g->grf_ref), free(g->q_wt), free(g->ivars), free(g->el_mem), free(g->el_lin);
-  free(g->el_pairs), free(g->prox_z0);
+  free(g->el_pairs), free(g->obj_mask), free(g->prox_z0);
   free(g->prox_w), free(g->umus), free(g->band), free(g->path_lb), free(g->path_ub);
   free(g);
 }
@@ -1434,11 +1522,39 @@ static int setup_workers(go_gait* g, char* err, int errsz) {
     g->ctx[w].mom = (double*)zalloc((size_t)na * nv, sizeof(double));
     g->ctx[w].dmom = (double*)zalloc((size_t)na * nv, sizeof(double));
     g->ctx[w].pos_q = (double*)zalloc((size_t)nv, sizeof(double));
+    g->ctx[w].hz = (double*)zalloc((size_t)3 * nz, sizeof(double));
     g->ctx_ptr[w] = &g->ctx[w];
     if (!g->ctx[w].d || !g->ctx[w].M || !g->ctx[w].P || !g->ctx[w].Pm || !g->ctx[w].zp ||
-        !g->ctx[w].mus || !g->ctx[w].mom || !g->ctx[w].dmom || !g->ctx[w].pos_q)
+        !g->ctx[w].mus || !g->ctx[w].mom || !g->ctx[w].dmom || !g->ctx[w].pos_q || !g->ctx[w].hz)
       return out_of_memory(err, errsz, "workers");
   }
+  return 0;
+}
+
+// g->obj_mask: the metabolic power's possible Hessian entries, both triangles. Muscle i's power
+// reads its a_i, e_i, fT_i (elastic tendon) and the coordinates and speeds of the dofs it
+// crosses, so every pair among those. 0, or -1 out of memory.
+static int metabolic_mask(go_gait* g) {
+  const go_gait_layout* L = &g->L;
+  int nz = L->nz, nv = L->nv;
+  g->obj_mask = (unsigned char*)zalloc((size_t)nz * (size_t)nz, 1);
+  int* V = (int*)zalloc((size_t)(2 * nv + 3), sizeof(int));
+  if (!g->obj_mask || !V) {
+    free(V);
+    return -1;
+  }
+  for (int j = 0; j < nz; j++) g->obj_mask[(size_t)j * nz + j] = 1;  // the squares
+  for (int i = 0; i < L->na; i++) {
+    int n = 0;
+    for (int j = 0; j < nv; j++)
+      if (g->cross[i * nv + j]) V[n++] = L->x_q + j, V[n++] = L->x_qd + j;
+    V[n++] = L->x_a + i;
+    V[n++] = L->u_e + i;
+    if (L->elastic_of[i] >= 0) V[n++] = L->x_ft + L->elastic_of[i];
+    for (int a = 0; a < n; a++)
+      for (int b = 0; b < n; b++) g->obj_mask[(size_t)V[a] * nz + V[b]] = 1;
+  }
+  free(V);
   return 0;
 }
 
@@ -1490,6 +1606,11 @@ static int setup_nlp(go_gait* g, const go_gait_opts* o, char* err, int errsz) {
   p.n_integrand_vars = g->n_ivars;
   p.integrand_grad = integrand_grad_cb;
   p.integrand_hess = integrand_hess_cb;
+  if (g->cot_scale > 0) {  // the metabolic power's mixed curvature, for the exact Hessian
+    if (metabolic_mask(g) != 0) return out_of_memory(err, errsz, "metabolic Hessian pattern");
+    p.integrand_hess_block = integrand_hess_block_cb;
+    p.integrand_hess_mask = g->obj_mask;
+  }
   p.outer = outer_cb;
   p.boundary = g->n_bnd > 0 ? boundary_cb : NULL;
   p.bnd_col_ptr = g->bnd_col_ptr;

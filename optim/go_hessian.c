@@ -54,6 +54,7 @@ typedef struct {
 
 typedef struct {
   double *zs, *z, *g0, *gp, *gn, *gq, *mu, *J0, *J1, *J2;  // gp, gn: nf x np
+  double* hobj;  // the integrand's node Hessian (nz x nz), when the problem gives it
 } fd_scratch;
 
 typedef struct go_hess_fd {
@@ -74,9 +75,12 @@ typedef struct go_hess_fd {
   int* cread_ptr;    // reads of colour c, `col` of a read is the perturbed variable (ncol + 1)
   fd_read* cread;
   int* cread_pert;   // perturbed variable of each (C) read
+  int nobj;          // the integrand's node Hessian (integrand_hess_block): entries (oi >= oj)
+  int *oi, *oj, *oent;  // of its mask's lower triangle and their node-local entries (nobj)
   fd_scratch* ws;    // per worker
   int nthreads;
   // current task
+  double obj_c;      // obj_factor dJ/dI h / obj_scale (the node weight left out); 0: no objective
   const double* x;
   const double* lambda;
   double* vals;
@@ -105,11 +109,11 @@ static int fail(char* err, int errsz, const char* msg, int a) {
 
 static void fd_free(go_hess_fd* f) {
   if (!f) return;
-  void* arrays[] = {f->fvar, f->fdiag, f->drow_ptr, f->drow, f->pa, f->pb, f->pent, f->prow_ptr,
-                    f->prow, f->bread_ptr, f->bread, f->cvar_ptr, f->cvar, f->cread_ptr, f->cread,
+  void* arrays[] = {f->oi,     f->oj,        f->oent,   f->fvar,      f->fdiag,  f->drow_ptr,
+                    f->drow,   f->pa,        f->pb,     f->pent,      f->prow_ptr, f->prow, f->bread_ptr, f->bread, f->cvar_ptr, f->cvar, f->cread_ptr, f->cread,
                     f->cread_pert, f->status};
   for (size_t i = 0; i < sizeof(arrays) / sizeof(arrays[0]); i++) free(arrays[i]);
-  for (int w = 0; f->ws && w < f->nthreads; w++) free(f->ws[w].zs);
+  for (int w = 0; f->ws && w < f->nthreads; w++) free(f->ws[w].zs), free(f->ws[w].hobj);
   free(f->ws);
   free(f);
 }
@@ -570,6 +574,19 @@ int go_hess_create_fd(go_hess** out, go_nlp* nlp, const go_elements* el, char* e
     if (!err[0]) fail(err, errsz, "out of memory (finite-difference Hessian)", 2);
     goto done;
   }
+  // the integrand's node Hessian, when the problem gives one: every entry of its mask
+  const unsigned char* omask = nlp->prob.integrand_hess_block && nlp->prob.integrand
+                                   ? nlp->prob.integrand_hess_mask : NULL;
+  if (nlp->prob.integrand_hess_block && nlp->prob.integrand && !omask) {
+    rc = fail(err, errsz, "integrand_hess_block without integrand_hess_mask", 0);
+    goto done;
+  }
+  for (int i = 0; omask && i < nz; i++)
+    for (int j = 0; j <= i; j++)
+      if (omask[(size_t)i * nz + j] || omask[(size_t)j * nz + i]) {
+        MARK(i, j);
+        f->nobj++;
+      }
   // the pattern of the entries produced, numbered row-major within a node
   int cnt = 0;
   for (int i = 0; i < nz; i++)
@@ -592,6 +609,20 @@ int go_hess_create_fd(go_hess** out, go_nlp* nlp, const go_elements* el, char* e
     goto done;
   }
   for (int a = 0; a < f->nf; a++) f->fdiag[a] = LOCAL(f->fvar[a], f->fvar[a]);
+  if (f->nobj > 0) {
+    f->oi = malloc(sizeof(int) * (size_t)f->nobj);
+    f->oj = malloc(sizeof(int) * (size_t)f->nobj);
+    f->oent = malloc(sizeof(int) * (size_t)f->nobj);
+    if (!f->oi || !f->oj || !f->oent) {
+      rc = fail(err, errsz, "out of memory (finite-difference Hessian)", 5);
+      goto done;
+    }
+    int t = 0;
+    for (int i = 0; i < nz; i++)
+      for (int j = 0; j <= i; j++)
+        if (omask[(size_t)i * nz + j] || omask[(size_t)j * nz + i])
+          f->oi[t] = i, f->oj[t] = j, f->oent[t++] = LOCAL(i, j);
+  }
   for (int t = 0; t < f->npair; t++) f->pent[t] = LOCAL(f->fvar[f->pa[t]], f->fvar[f->pb[t]]);
   for (int t = 0; t < bread.n; t++) {
     fd_read* rd = &bread.v[t];
@@ -631,6 +662,8 @@ int go_hess_create_fd(go_hess** out, go_nlp* nlp, const go_elements* el, char* e
     s->J2 = s->J1 + nlp->nnz_p;
     s->gp = s->J2 + nlp->nnz_p;  // nf x np
     s->gn = s->gp + (size_t)f->nf * np;
+    if (f->nobj > 0 && !(s->hobj = malloc(sizeof(double) * (size_t)nz * (size_t)nz)))
+      rc = fail(err, errsz, "out of memory (finite-difference Hessian)", 6);
   }
 #undef HAS
 #undef MARK
@@ -755,8 +788,41 @@ static int fd_node(go_hess* h, int w, int k) {
                     (s->J1[rd->p] - s->J2[rd->p]) / (2 * hv);
     }
   }
+  // the integrand's node block, obj_factor dJ/dI h w_k / obj_scale times its physical Hessian
+  if (f->nobj > 0 && f->obj_c != 0) {
+    for (int j = 0; j < nz; j++) s->z[j] = x[j] * nlp->zscale[j];
+    if (nlp->prob.integrand_hess_block(go_nlp_ctx(nlp, w), k, s->z, s->hobj) != 0) return -1;
+    double c = f->obj_c * go_nlp_weight(nlp, k);
+    for (int t = 0; t < f->nobj; t++) {
+      int i = f->oi[t], j = f->oj[t];
+      H[f->oent[t]] += c * nlp->zscale[i] * nlp->zscale[j] * s->hobj[(size_t)i * nz + j];
+    }
+  }
   for (int t = 0; t < h->nnz_node; t++)
     if (!isfinite(H[t])) return -1;
+  return 0;
+}
+
+// obj_factor dJ/dI h / obj_scale at x (the integrand's factor in the objective, the node weight
+// left out) into *c; 0, or -1 with the reason in nlp->err
+static int objective_factor(go_nlp* nlp, const double* x, double obj_factor, double* c) {
+  int N = nlp->N;
+  double T = go_nlp_time(nlp, x), h = T / (N - 1), S = 0.0, J, dJdI = 1.0, dJdT;
+  if (nlp->prob.outer) {  // outer() needs I: the integrand at every node (serial, cheap)
+    for (int k = 0; k < N; k++) {
+      double L;
+      if (go_nlp_node_L(nlp, 0, k, x, &L)) {
+        snprintf(nlp->err, sizeof(nlp->err), "hessian: the integrand failed at node %d", k);
+        return -1;
+      }
+      S += go_nlp_weight(nlp, k) * L;
+    }
+    if (nlp->prob.outer(go_nlp_ctx(nlp, 0), S * h, T, &J, &dJdI, &dJdT) != 0 || !isfinite(dJdI)) {
+      snprintf(nlp->err, sizeof(nlp->err), "objective outer(): failed or non-finite");
+      return -1;
+    }
+  }
+  *c = obj_factor * dJdI * h / nlp->obj_scale;
   return 0;
 }
 
@@ -769,16 +835,17 @@ static int fd_values(go_hess* h, const double* x, double obj_factor, const doubl
                      double* vals) {
   go_nlp* nlp = h->nlp;
   go_hess_fd* f = h->fd;
-  f->x = x, f->lambda = lambda, f->vals = vals;
+  f->x = x, f->lambda = lambda, f->vals = vals, f->obj_c = 0;
+  if (f->nobj > 0 && obj_factor != 0 && objective_factor(nlp, x, obj_factor, &f->obj_c)) return -1;
   go_pool_run(nlp->pool, nlp->N, fd_task, h);
   for (int k = 0; k < nlp->N; k++) {
     if (f->status[k]) {
-      snprintf(nlp->err, sizeof(nlp->err), "hessian: a path evaluation failed at node %d", k);
+      snprintf(nlp->err, sizeof(nlp->err), "hessian: a path or integrand evaluation failed at node %d", k);
       return -1;
     }
   }
   if (nlp->free_time) vals[h->nnz - 1] = 0;
-  if (add_objective_diagonal(h, x, obj_factor, vals)) return -1;
+  if (f->nobj == 0 && add_objective_diagonal(h, x, obj_factor, vals)) return -1;
   h->updates++;
   return 0;
 }

@@ -48,6 +48,7 @@ void go_solve_plan_default(go_solve_plan* p) {
   p->ipopt.fallback_rise = GO_FALLBACK_RISE;
   p->ipopt.fallback_viol = GO_FALLBACK_VIOL;
   p->hessian = GO_HESSIAN_LBFGS;
+  p->gn_mu_init = GO_GN_MU_INIT;
   p->max_iter = -1;
   p->max_restarts = GO_MAX_RESTARTS;
   p->refine_iter = GO_REFINE_ITER;
@@ -252,14 +253,17 @@ static int main_solve(run_state* s, go_ipopt_opts* opts, go_solve_report* rep, c
   return 0;
 }
 
-// stage 3: exact-Hessian refinement of an L-BFGS solve that stopped short, from its best iterate
+// stage 3: exact-Hessian refinement of an L-BFGS or Gauss-Newton main solve that stopped short,
+// from its best iterate
 // with a small barrier (mu 1e-6, bound multipliers mu / s, the point barely pushed off its
 // bounds); 0 or -1 with err
 static int refine(run_state* s, const go_ipopt_opts* opts, go_solve_report* rep, char* err,
                   int errsz) {
   const go_solve_plan* p = s->p;
   go_solve_result* res = &rep->result;
-  if (!(p->refine_iter > 0 && p->hessian == GO_HESSIAN_LBFGS && res->best_iter >= 0 &&
+  if (!(p->refine_iter > 0 &&
+        (p->hessian == GO_HESSIAN_LBFGS || p->hessian == GO_HESSIAN_GAUSS_NEWTON) &&
+        res->best_iter >= 0 &&
         !solve_converged(res) && res->status != GO_SOLVE_INTERRUPTED &&
         (p->max_wall_s <= 0 || res->wall_s < p->max_wall_s)))
     return 0;
@@ -272,6 +276,7 @@ static int refine(run_state* s, const go_ipopt_opts* opts, go_solve_report* rep,
   double budget = p->max_wall_s > 0 ? fmin(p->max_wall_s - res->wall_s, p->refine_wall_s)
                                     : p->refine_wall_s;
   go_ipopt_opts ro = *opts;
+  ro.gauss_newton = 0;
   ro.max_wall_s = budget;
   ro.handover_iter = 0;
   if (set_start_near_solution(&ro, why, sizeof(why)) != 0) {
@@ -308,7 +313,7 @@ static int refine(run_state* s, const go_ipopt_opts* opts, go_solve_report* rep,
     // Newton starts where Gauss-Newton stopped: its iterates stay 1e-2 - 1e-1 off the dynamics,
     // which Newton's first iterations take back to 1e-4 at about the same objective (a
     // projection onto the dynamics does not: the nearest consistent point lets the pelvis
-    // drift); unless Gauss-Newton failed, when Newton starts from the L-BFGS best iterate
+    // drift); unless Gauss-Newton failed, when Newton starts from the main solve's best iterate
     int gn_usable = isfinite(gres->objective) && isfinite(gres->max_viol) &&
                     !gres->last_restoration &&
                     (gres->status == GO_SOLVE_MAX_ITER || solve_converged(gres));
@@ -316,7 +321,7 @@ static int refine(run_state* s, const go_ipopt_opts* opts, go_solve_report* rep,
     ro.max_wall_s = budget - gres->wall_s;
     if (gres->status == GO_SOLVE_INTERRUPTED || ro.max_wall_s <= 0) {
       // nothing left for Newton: the Gauss-Newton phase stands for the refinement, its best
-      // iterate (by the usual ranking) kept when it beats the L-BFGS one
+      // iterate (by the usual ranking) kept when it beats the main solve's
       rep->refine = *gres;
       rep->refined = gres->best_iter >= 0 &&
                      go_ipopt_point_better(gres->best_objective, gres->best_viol,
@@ -340,7 +345,7 @@ static int refine(run_state* s, const go_ipopt_opts* opts, go_solve_report* rep,
     return -1;
   }
   if (rep->refine_gn_run) continue_result(rres, gres);
-  // used: converged, or stopped short at a best iterate that beats the L-BFGS one by the glue's
+  // used: converged, or stopped short at a best iterate that beats the main solve's by the glue's
   // ranking (among points the polish can take, the lower objective)
   rep->refined = solve_converged(rres) ||
                  (rres->best_iter >= 0 &&
@@ -351,8 +356,8 @@ static int refine(run_state* s, const go_ipopt_opts* opts, go_solve_report* rep,
             p->label, go_solve_status_str(rres->status), rres->iterations, rres->wall_s,
             rres->objective,
             solve_converged(rres) ? ""
-            : rep->refined ? "; its best iterate beats the L-BFGS one and is kept"
-                           : "; the L-BFGS best iterate stays");
+            : rep->refined ? "; its best iterate beats the main solve's and is kept"
+                           : "; the main solve's best iterate stays");
 kept:
   if (rep->refined) {
     memcpy(s->zb, s->zs, sizeof(double) * (size_t)s->n);
@@ -434,6 +439,17 @@ static int run_stages(run_state* s, go_solve_report* rep, char* err, int errsz) 
   }
   // the main solve's options and Hessian
   go_ipopt_opts opts = p->ipopt;
+  if (p->hessian == GO_HESSIAN_GAUSS_NEWTON && p->gn_mu_init > 0) {
+    // mu_init in front of the caller's options, so that one of theirs (later) overrides it
+    if (opts.n_kv >= GO_IPOPT_MAX_OPTIONS) {
+      snprintf(err, (size_t)errsz, "more than %d Ipopt options", GO_IPOPT_MAX_OPTIONS - 1);
+      return -1;
+    }
+    memmove(opts.kv + 1, opts.kv, sizeof(opts.kv[0]) * (size_t)opts.n_kv);
+    snprintf(opts.kv[0].key, sizeof(opts.kv[0].key), "mu_init");
+    snprintf(opts.kv[0].val, sizeof(opts.kv[0].val), "%.17g", p->gn_mu_init);
+    opts.n_kv++;
+  }
   opts.max_iter = p->max_iter;
   opts.max_wall_s = p->max_wall_s;
   opts.progress = f;

@@ -5,15 +5,16 @@
 //   2. restarts: after a fall-back (GO_SOLVE_FELL_BACK: Ipopt came near a solution, violation
 //      <= fallback_viol, and left it), again from the best iterate with the iterations and time
 //      left, a small barrier and the point barely pushed off its bounds; at most max_restarts;
-//   3. refinement: an L-BFGS solve that stopped short (not converged, not interrupted; with
-//      handover_iter, at its first nearly feasible iterate from that iteration on) is
+//   3. refinement: an L-BFGS or Gauss-Newton main solve that stopped short (not converged, not
+//      interrupted; with handover_iter, at its first nearly feasible iterate from that iteration
+//      on) is
 //      followed, from its best iterate, by refine_gn_iter Gauss-Newton iterations (the goals'
 //      Hessian, positive semi-definite) and, from where they stop, up to refine_iter Newton
 //      iterations with the exact Hessian (structured finite differences, go_hess_create_fd),
 //      stopped by Ipopt's tests or the settled rule (settle_iter, settle_rel, settle_viol:
-//      GO_SOLVE_SETTLED); their result replaces the L-BFGS one when they converge (Ipopt's
+//      GO_SOLVE_SETTLED); their result replaces the main solve's when they converge (Ipopt's
 //      optimal or acceptable level, or settled), and so does their best iterate when it beats
-//      the L-BFGS one (go_ipopt_point_better); else the L-BFGS best iterate stays;
+//      the main solve's one (go_ipopt_point_better); else the main solve's best iterate stays;
 //   4. the point chosen: Ipopt's when it converged by its own tests (or no iterate was scored),
 //      else (stopped short, or settled) the best iterate;
 //   5. feasibility polish: when that point is violated by more than 1e-8, the dynamically
@@ -39,10 +40,11 @@
 
 // the Hessian of the main solve
 typedef enum {
-  GO_HESSIAN_LBFGS = 0,     // Ipopt's limited-memory quasi-Newton (the only one refined)
+  GO_HESSIAN_LBFGS = 0,     // Ipopt's limited-memory quasi-Newton (refined when it stops short)
   GO_HESSIAN_PQN,           // partitioned quasi-Newton, SR1 per node element (go_hess_create)
   GO_HESSIAN_EXACT,         // structured finite differences (go_hess_create_fd)
-  GO_HESSIAN_GAUSS_NEWTON,  // exact for the tracking squares, constraints left out
+  GO_HESSIAN_GAUSS_NEWTON,  // exact for the tracking squares, constraints left out (refined
+                            // when it stops short, as L-BFGS)
 } go_hessian_kind;
 
 // a start on both clocks (go_clock_start)
@@ -65,6 +67,9 @@ typedef struct {
                               // order); max_iter, max_wall_s, progress, handle_sigint and hess
                               // are set from the fields below
   go_hessian_kind hessian;    // Hessian of the main solve
+  double gn_mu_init;          // a Gauss-Newton main solve's initial barrier parameter (Ipopt's
+                              // mu_init, -), placed before the caller's options so that theirs
+                              // wins; <= 0: Ipopt's default (0.1)
   int max_iter;               // Ipopt iterations of the main solve and its restarts together
                               // (-); < 0: Ipopt's default
   double max_wall_s;          // wall-clock limit (s); <= 0: none. The main solve and its

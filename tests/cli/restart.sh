@@ -16,7 +16,7 @@ gaitsim=$1 src=$2
 source "$(dirname "$0")/../cli_common.bash"
 
 "$gaitsim" track "$src/mjmodels/trials/jw_ngait_og5" --out track --model "$src/mjmodels/gait2d.xml" \
-  --nodes 20 --max-iter 100 --threads 2 --refine 0 >/dev/null 2>&1
+  --nodes 20 --hessian lbfgs --max-iter 100 --threads 2 --refine 0 >/dev/null 2>&1
 check "guess written" test -s track/variables.sto
 "$gaitsim" predict --guess track --model "$src/mjmodels/gait2d.xml" --speed 1.2 --nodes 20 \
   --max-iter 600 --threads 2 --out pred --fallback-rise 1e-4 >/dev/null 2>log.txt

@@ -48,8 +48,8 @@ static const char* kRunUsage =
     GO_STR(GO_MAX_ITER) ": an iteration\n"
     "                 budget, not a time limit, so that the results do not depend on the load\n"
     "                 of the machine; in the measured main job (docs/BENCHMARKS.md) they\n"
-    "                 reached Ipopt's acceptable level after 1450 (0.8 m/s) and 811 (2.0 m/s)\n"
-    "                 iterations, about 27 minutes side by side on 2 cores)\n"
+    "                 reached Ipopt's acceptable level after 243 (0.8 m/s) and 882 (2.0 m/s)\n"
+    "                 iterations, 6 and 25 minutes side by side on 2 cores)\n"
     "  --nodes N      collocation nodes of every solve (default " GO_STR(GO_NODES_MAIN_JOB)
     "; 20 gives a coarse\n"
     "                 look in minutes)\n"

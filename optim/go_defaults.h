@@ -20,9 +20,10 @@
 #define GO_MAX_ITER 2500           // each prediction: gaitsim predict, each speed of sweep and of
                                    // run's main job (--max-iter). An iteration budget, not a time
                                    // limit, so results do not depend on the load of the machine;
-                                   // at 80 nodes the main job's 0.8 m/s prediction reached
-                                   // Ipopt's acceptable level after 1450 iterations, its 2.0 m/s
-                                   // one after 811
+                                   // at 80 nodes the main job's predictions reached Ipopt's
+                                   // acceptable level after 243 (0.8 m/s) and 882 (2.0 m/s)
+                                   // iterations; from another 80-node tracking solution 1450 and
+                                   // 811 (docs/BENCHMARKS.md)
 #define GO_MAX_ITER_TRACK 60       // track's main solve, Gauss-Newton from the trial's guess at
                                    // barrier GO_GN_MU_INIT, before the refinement (--max-iter).
                                    // At N = 80 it brings the violation from 182 to about 0.1 at

@@ -600,7 +600,7 @@ static int integrand_hess_cb(void* vctx, int k, const double* z, double* d2L) {
 
 // The integrand's whole Hessian at node k (go_integrand_hess_block_fn): the squares' diagonal
 // (integrand_hess_cb) plus the metabolic power's Hessian, by central differences of its
-// chain-rule gradient (metabolic) with a step of 1e-4 max(1, |z_j|):
+// chain-rule gradient (metabolic) with a step of 1e-4 max(z_scale_j, |z_j|) (step_of):
 //   - a column for each coordinate and speed of a dof some muscle crosses (2 gradients each);
 //   - one perturbation of every muscle's activation at once, one of every excitation, one of
 //     every tendon force: muscle i's power reads only its own a_i, e_i and fT_i besides q and

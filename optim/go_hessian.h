@@ -92,8 +92,12 @@ int go_hess_values(go_hess* h, const double* x, double obj_factor, const double*
 // Costs per node and Hessian: 1 + 2 n_fd + n_pairs path evaluations, 1 + n_fd + 2 n_colours
 // path_jac calls (full body: 26 dofs -> n_fd 52; see docs/BENCHMARKS.md). The pattern holds only
 // the entries these produce (structural zeros of lin x lin left out) and every diagonal. The
-// objective adds its exact diagonal (go_nlp_eval_hess_diag) when the problem has one; otherwise
-// the objective's curvature is left out. With a free T the defects' T x xdot curvature is left out.
+// objective adds its node Hessian when the problem gives one (integrand_hess_block, its mask's
+// entries added to the pattern; e.g. a prediction's metabolic power), else its exact diagonal
+// (go_nlp_eval_hess_diag) when the problem has one; otherwise the objective's curvature is left
+// out. Either is scaled by obj_factor dJ/dI h w_k / obj_scale: outer()'s own curvature is left
+// out (the cost of transport I / T with I = h sum w_k L_k has none). With a free T the defects'
+// T x xdot curvature is left out.
 // Rows in no element are taken as linear. Same arguments and results as go_hess_create.
 // Measured (docs/BENCHMARKS.md, "Resolution"): 8468 Hessian entries per node of jw_fullbody and
 // about 910 path evaluations per node and Hessian (tests/test_hessian_fd.c prints both); at N = 80

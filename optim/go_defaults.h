@@ -35,6 +35,18 @@
                                    // mu_init, -): from Ipopt's 0.1 the Gauss-Newton steps stay
                                    // tiny (J 54 after 300 iterations at N = 20); from 1e-4 they
                                    // are full within 40
+#define GO_MIN_HESS_PERTURBATION 0.1  // the smallest regularisation delta_w of Ipopt's inertia
+                                   // correction in the Gauss-Newton and Newton solves (-; Ipopt's
+                                   // default 1e-20). Where the Lagrangian's Hessian is indefinite
+                                   // on the constraints' null space, Ipopt shifts it by delta_w,
+                                   // lowering delta_w by 3 each iteration: from 1e-3 shifts the
+                                   // Newton steps ran long along nearly flat directions and left
+                                   // the violation at 1e-3 - 4e-2 every other iteration, so that
+                                   // jw_bouncy7's 80-node track never settled (82 iterations,
+                                   // exit 3); with a floor of 0.1 it settles after 23 Newton
+                                   // iterations, and jw_ngait_og5's after 18 instead of 96, at
+                                   // the same Table 1 figures (docs/BENCHMARKS.md, "A floor
+                                   // under the Hessian regularisation")
 #define GO_HANDOVER_ITER_TRACK 0   // with --hessian lbfgs and --refine-after N > 0, L-BFGS
                                    // hands over to the refinement at its first iterate from
                                    // iteration N on at a violation <= 1e-3. Off: on

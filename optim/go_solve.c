@@ -49,6 +49,7 @@ void go_solve_plan_default(go_solve_plan* p) {
   p->ipopt.fallback_viol = GO_FALLBACK_VIOL;
   p->hessian = GO_HESSIAN_LBFGS;
   p->gn_mu_init = GO_GN_MU_INIT;
+  p->min_hess_perturbation = GO_MIN_HESS_PERTURBATION;
   p->max_iter = -1;
   p->max_restarts = GO_MAX_RESTARTS;
   p->refine_iter = GO_REFINE_ITER;
@@ -253,6 +254,21 @@ static int main_solve(run_state* s, go_ipopt_opts* opts, go_solve_report* rep, c
   return 0;
 }
 
+// key = value in front of opts' options, so that one of the caller's (later) overrides it; 0, or
+// -1 with err when the list is full
+static int prepend_option(go_ipopt_opts* opts, const char* key, double value, char* err,
+                          int errsz) {
+  if (opts->n_kv >= GO_IPOPT_MAX_OPTIONS) {
+    snprintf(err, (size_t)errsz, "more than %d Ipopt options", GO_IPOPT_MAX_OPTIONS - 1);
+    return -1;
+  }
+  memmove(opts->kv + 1, opts->kv, sizeof(opts->kv[0]) * (size_t)opts->n_kv);
+  snprintf(opts->kv[0].key, sizeof(opts->kv[0].key), "%s", key);
+  snprintf(opts->kv[0].val, sizeof(opts->kv[0].val), "%.17g", value);
+  opts->n_kv++;
+  return 0;
+}
+
 // stage 3: exact-Hessian refinement of an L-BFGS or Gauss-Newton main solve that stopped short,
 // from its best iterate
 // with a small barrier (mu 1e-6, bound multipliers mu / s, the point barely pushed off its
@@ -278,6 +294,9 @@ static int refine(run_state* s, const go_ipopt_opts* opts, go_solve_report* rep,
   go_ipopt_opts ro = *opts;
   ro.gauss_newton = 0;
   ro.max_wall_s = budget;
+  if (p->hessian == GO_HESSIAN_LBFGS && p->min_hess_perturbation > 0 &&
+      prepend_option(&ro, "min_hessian_perturbation", p->min_hess_perturbation, err, errsz) != 0)
+    return -1;
   ro.handover_iter = 0;
   if (set_start_near_solution(&ro, why, sizeof(why)) != 0) {
     snprintf(err, (size_t)errsz, "refine: %s", why);
@@ -439,17 +458,12 @@ static int run_stages(run_state* s, go_solve_report* rep, char* err, int errsz) 
   }
   // the main solve's options and Hessian
   go_ipopt_opts opts = p->ipopt;
-  if (p->hessian == GO_HESSIAN_GAUSS_NEWTON && p->gn_mu_init > 0) {
-    // mu_init in front of the caller's options, so that one of theirs (later) overrides it
-    if (opts.n_kv >= GO_IPOPT_MAX_OPTIONS) {
-      snprintf(err, (size_t)errsz, "more than %d Ipopt options", GO_IPOPT_MAX_OPTIONS - 1);
-      return -1;
-    }
-    memmove(opts.kv + 1, opts.kv, sizeof(opts.kv[0]) * (size_t)opts.n_kv);
-    snprintf(opts.kv[0].key, sizeof(opts.kv[0].key), "mu_init");
-    snprintf(opts.kv[0].val, sizeof(opts.kv[0].val), "%.17g", p->gn_mu_init);
-    opts.n_kv++;
-  }
+  int second_order = p->hessian == GO_HESSIAN_GAUSS_NEWTON || p->hessian == GO_HESSIAN_EXACT;
+  if ((p->hessian == GO_HESSIAN_GAUSS_NEWTON && p->gn_mu_init > 0 &&
+       prepend_option(&opts, "mu_init", p->gn_mu_init, err, errsz) != 0) ||
+      (second_order && p->min_hess_perturbation > 0 &&
+       prepend_option(&opts, "min_hessian_perturbation", p->min_hess_perturbation, err, errsz)))
+    return -1;
   opts.max_iter = p->max_iter;
   opts.max_wall_s = p->max_wall_s;
   opts.progress = f;

@@ -70,6 +70,11 @@ typedef struct {
   double gn_mu_init;          // a Gauss-Newton main solve's initial barrier parameter (Ipopt's
                               // mu_init, -), placed before the caller's options so that theirs
                               // wins; <= 0: Ipopt's default (0.1)
+  double min_hess_perturbation;  // the smallest Hessian regularisation of Ipopt's inertia
+                              // correction (min_hessian_perturbation, -) in every solve with a
+                              // Gauss-Newton or exact Hessian (the main solve, the
+                              // refinement's phases; not the polish), placed before the
+                              // caller's options; <= 0: Ipopt's default (1e-20)
   int max_iter;               // Ipopt iterations of the main solve and its restarts together
                               // (-); < 0: Ipopt's default
   double max_wall_s;          // wall-clock limit (s); <= 0: none. The main solve and its

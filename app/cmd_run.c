@@ -47,9 +47,10 @@ static const char* kRunUsage =
     "  --max-iter N   Ipopt iteration limit of each predictive solve (default "
     GO_STR(GO_MAX_ITER) ": an iteration\n"
     "                 budget, not a time limit, so that the results do not depend on the load\n"
-    "                 of the machine; in the measured main job (docs/BENCHMARKS.md) they\n"
-    "                 reached Ipopt's acceptable level after 243 (0.8 m/s) and 882 (2.0 m/s)\n"
-    "                 iterations, 6 and 25 minutes side by side on 2 cores)\n"
+    "                 of the machine; in the last main job measured to the end\n"
+    "                 (docs/BENCHMARKS.md) they reached Ipopt's acceptable level after 243\n"
+    "                 (0.8 m/s) and 882 (2.0 m/s) iterations, 6 and 25 minutes side by side\n"
+    "                 on 2 cores; from the current tracking solution both took over 1040)\n"
     "  --nodes N      collocation nodes of every solve (default " GO_STR(GO_NODES_MAIN_JOB)
     "; 20 gives a coarse\n"
     "                 look in minutes)\n"

@@ -50,7 +50,8 @@ static const char* kRunUsage =
     "                 of the machine; in the last main job measured to the end\n"
     "                 (docs/BENCHMARKS.md) they reached Ipopt's acceptable level after 243\n"
     "                 (0.8 m/s) and 882 (2.0 m/s) iterations, 6 and 25 minutes side by side\n"
-    "                 on 2 cores; from the current tracking solution both took over 1040)\n"
+    "                 on 2 cores; from the current tracking solution 1389 and 1098, 36 and\n"
+    "                 29 CPU-minutes)\n"
     "  --nodes N      collocation nodes of every solve (default " GO_STR(GO_NODES_MAIN_JOB)
     "; 20 gives a coarse\n"
     "                 look in minutes)\n"

@@ -803,29 +803,6 @@ static int fd_node(go_hess* h, int w, int k) {
   return 0;
 }
 
-// obj_factor dJ/dI h / obj_scale at x (the integrand's factor in the objective, the node weight
-// left out) into *c; 0, or -1 with the reason in nlp->err
-static int objective_factor(go_nlp* nlp, const double* x, double obj_factor, double* c) {
-  int N = nlp->N;
-  double T = go_nlp_time(nlp, x), h = T / (N - 1), S = 0.0, J, dJdI = 1.0, dJdT;
-  if (nlp->prob.outer) {  // outer() needs I: the integrand at every node (serial, cheap)
-    for (int k = 0; k < N; k++) {
-      double L;
-      if (go_nlp_node_L(nlp, 0, k, x, &L)) {
-        snprintf(nlp->err, sizeof(nlp->err), "hessian: the integrand failed at node %d", k);
-        return -1;
-      }
-      S += go_nlp_weight(nlp, k) * L;
-    }
-    if (nlp->prob.outer(go_nlp_ctx(nlp, 0), S * h, T, &J, &dJdI, &dJdT) != 0 || !isfinite(dJdI)) {
-      snprintf(nlp->err, sizeof(nlp->err), "objective outer(): failed or non-finite");
-      return -1;
-    }
-  }
-  *c = obj_factor * dJdI * h / nlp->obj_scale;
-  return 0;
-}
-
 static void fd_task(void* arg, int w, int k) {
   go_hess* h = arg;
   h->fd->status[k] = fd_node(h, w, k);
@@ -836,7 +813,11 @@ static int fd_values(go_hess* h, const double* x, double obj_factor, const doubl
   go_nlp* nlp = h->nlp;
   go_hess_fd* f = h->fd;
   f->x = x, f->lambda = lambda, f->vals = vals, f->obj_c = 0;
-  if (f->nobj > 0 && obj_factor != 0 && objective_factor(nlp, x, obj_factor, &f->obj_c)) return -1;
+  if (f->nobj > 0 && obj_factor != 0) {  // obj_factor dJ/dI h / obj_scale (node weight apart)
+    double step, dJdI;
+    if (go_nlp_integrand_factor(nlp, x, "hessian", &step, &dJdI)) return -1;
+    f->obj_c = obj_factor * dJdI * step / nlp->obj_scale;
+  }
   go_pool_run(nlp->pool, nlp->N, fd_task, h);
   for (int k = 0; k < nlp->N; k++) {
     if (f->status[k]) {

@@ -302,27 +302,37 @@ int go_nlp_has_hess_diag(const go_nlp* nlp) {
   return nlp->prob.integrand != NULL && nlp->prob.integrand_hess != NULL;
 }
 
+int go_nlp_integrand_factor(go_nlp* nlp, const double* zs, const char* who, double* h,
+                            double* dJdI) {
+  int N = nlp->N;
+  // integrand at every node for outer()'s dJ/dI (serial: N cheap evaluations)
+  double T = go_nlp_time(nlp, zs), S = 0.0, J, dJdT;
+  *h = T / (N - 1);
+  *dJdI = 1.0;
+  for (int k = 0; k < N; k++) {
+    double L;
+    if (go_nlp_node_L(nlp, 0, k, zs, &L)) {
+      snprintf(nlp->err, sizeof(nlp->err), "%s: integrand failed at node %d", who, k);
+      return -1;
+    }
+    S += go_nlp_weight(nlp, k) * L;
+  }
+  if (nlp->prob.outer &&
+      (nlp->prob.outer(go_nlp_ctx(nlp, 0), S * *h, T, &J, dJdI, &dJdT) != 0 || !isfinite(*dJdI))) {
+    snprintf(nlp->err, sizeof(nlp->err), "objective outer(): failed or non-finite");
+    return -1;
+  }
+  return 0;
+}
+
 int go_nlp_eval_hess_diag(go_nlp* nlp, const double* zs, double obj_factor, double* diag) {
   int nz = nlp->nz, N = nlp->N;
   if (!go_nlp_has_hess_diag(nlp)) {
     snprintf(nlp->err, sizeof(nlp->err), "Gauss-Newton Hessian: the problem has no integrand_hess");
     return -1;
   }
-  // integrand at every node for outer()'s dJ/dI (serial: N cheap evaluations)
-  double T = go_nlp_time(nlp, zs), h = T / (N - 1), S = 0.0, J, dJdI = 1.0, dJdT;
-  for (int k = 0; k < N; k++) {
-    double L;
-    if (go_nlp_node_L(nlp, 0, k, zs, &L)) {
-      snprintf(nlp->err, sizeof(nlp->err), "Gauss-Newton Hessian: integrand failed at node %d", k);
-      return -1;
-    }
-    S += go_nlp_weight(nlp, k) * L;
-  }
-  if (nlp->prob.outer &&
-      (nlp->prob.outer(go_nlp_ctx(nlp, 0), S * h, T, &J, &dJdI, &dJdT) != 0 || !isfinite(dJdI))) {
-    snprintf(nlp->err, sizeof(nlp->err), "objective outer(): failed or non-finite");
-    return -1;
-  }
+  double h, dJdI;
+  if (go_nlp_integrand_factor(nlp, zs, "Gauss-Newton Hessian", &h, &dJdI)) return -1;
   // node diagonals, in the solver's scaling
   go_worker* wk = &nlp->workers[0];
   for (int k = 0; k < N; k++) {

@@ -116,5 +116,9 @@ int go_nlp_boundary(go_nlp* nlp, int w, const double* zs, double* b);
 void go_nlp_task(void* arg, int w, int item);
 int go_nlp_check_status(go_nlp* nlp, int nitems, const char* what);
 void go_nlp_defects(const go_nlp* nlp, const double* zs, double* g);
+// the integrand's factor in the objective at zs: h = T / (N - 1) and outer()'s dJ/dI (1 without
+// outer), from the integrand at every node; 0, or -1 with "WHO: ..." in nlp->err
+int go_nlp_integrand_factor(go_nlp* nlp, const double* zs, const char* who, double* h,
+                            double* dJdI);
 
 #endif  // GAITSIM_OPTIM_GO_NLP_INTERNAL_H_

@@ -883,7 +883,13 @@ static const char* kPredictUsage =
     "around the guess (eq. 3: 20 deg, 5 cm, 6 rad/s, 1 m/s), started from the solution in\n"
     "TRACK_DIR (its forward progression rescaled to V). Writes the files of `gaitsim track`;\n"
     "summary.json adds stride time and length, their change from the guess, the cost of\n"
-    "transport and peak triceps surae excitations. Exit status 3 when the solver stopped short.\n\n"
+    "transport and peak triceps surae excitations. L-BFGS (Ipopt's limited-memory Hessian)\n"
+    "stops at Ipopt's optimal or acceptable level, or once the objective has settled: "
+    GO_STR(GO_SETTLE_ITER) " of\n"
+    "the last 2 x " GO_STR(GO_SETTLE_ITER) " iterations at a violation <= " GO_STR(GO_PREDICT_SETTLE_VIOL)
+    ", their objectives within " GO_STR(GO_SETTLE_REL) " relative per\n"
+    "iteration (status \"objective settled\"); then the polish onto the dynamics. Exit status 3\n"
+    "when the solver stopped short.\n\n"
     "  --model FILE        MJCF model (default: the one TRACK_DIR/summary.json names, else\n"
     "                      mjmodels/jw_fullbody_knee6.xml)\n"
     "  --nodes N           collocation nodes (default: the guess's, TRACK_DIR/summary.json\n"
@@ -946,6 +952,7 @@ int gs_cmd_predict(int argc, char** argv) {
   o.plan.refine_iter = 0;  // Newton after L-BFGS settles at a higher cost (docs/BENCHMARKS.md,
                            // "Predictions: the metabolic Hessian and Newton")
   o.plan.max_iter = GO_MAX_ITER;
+  o.plan.settle_main_viol = GO_PREDICT_SETTLE_VIOL;
   o.nodes = GO_NODES_PREDICT;
   o.w_effort = GO_PREDICT_W_EFFORT;
   o.w_accel = GO_PREDICT_W_ACCEL;

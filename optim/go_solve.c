@@ -43,6 +43,13 @@ void go_solve_plan_default(go_solve_plan* p) {
       {"acceptable_iter", "15"}, {"limited_memory_max_history", "20"}};
   for (size_t i = 0; i < sizeof(stop_rule) / sizeof(stop_rule[0]); i++)
     go_ipopt_opts_set(&p->ipopt, stop_rule[i][0], stop_rule[i][1], err, sizeof(err));
+  // the limited-memory Hessian's KKT systems: one factorisation of the augmented system extended
+  // by the 2 x 20 low-rank columns, instead of Ipopt's default Sherman-Morrison update, which
+  // re-solves the system for each of those columns at every iteration (the barrier diagonal
+  // changes the factor each time). At N = 80 the 40 back-solves took 57 % of an L-BFGS
+  // iteration; extended, a prediction's iteration costs 0.96 s instead of 1.5 s on one core
+  // (docs/BENCHMARKS.md, "The L-BFGS phase: the low-rank back-solves")
+  go_ipopt_opts_set(&p->ipopt, "limited_memory_aug_solver", "extended", err, sizeof(err));
   // fall-back guard: stop when the objective rises GO_FALLBACK_RISE above the lowest one
   // reached at a violation <= GO_FALLBACK_VIOL, and restart from the best iterate
   p->ipopt.fallback_rise = GO_FALLBACK_RISE;
@@ -298,6 +305,7 @@ static int refine(run_state* s, const go_ipopt_opts* opts, go_solve_report* rep,
       prepend_option(&ro, "min_hessian_perturbation", p->min_hess_perturbation, err, errsz) != 0)
     return -1;
   ro.handover_iter = 0;
+  ro.settle_iter = 0;  // the Gauss-Newton phase runs its iterations; Newton's rule is set below
   if (set_start_near_solution(&ro, why, sizeof(why)) != 0) {
     snprintf(err, (size_t)errsz, "refine: %s", why);
     return -1;
@@ -477,6 +485,11 @@ static int run_stages(run_state* s, go_solve_report* rep, char* err, int errsz) 
     return -1;
   }
   opts.hess = s->hess;
+  if (p->settle_main_viol > 0) {
+    opts.settle_iter = p->settle_iter;
+    opts.settle_rel = p->settle_rel;
+    opts.settle_viol = p->settle_main_viol;
+  }
   if (p->handover_iter > 0 && p->refine_iter > 0 && p->hessian == GO_HESSIAN_LBFGS) {
     opts.handover_iter = p->handover_iter;
     opts.handover_viol = opts.best_viol_tol;

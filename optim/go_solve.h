@@ -93,6 +93,9 @@ typedef struct {
   int settle_iter;            // the refinement's settled rule (go_ipopt_opts.settle_iter, -)
   double settle_rel;          // its relative objective change per iteration (-)
   double settle_viol;         // its violation (scaled, max norm, -)
+  double settle_main_viol;    // > 0: the main solve and its restarts stop by the settled rule
+                              // too (settle_iter, settle_rel) at this violation (scaled, max
+                              // norm, -); 0: by Ipopt's tests alone
   int polish;                 // 1: feasibility polish of the point chosen
   int polish_iter;            // polish iterations at most (-)
   double stop_polish_wall_s;  // polish's wall-clock cap after a stop signal (s)

@@ -884,12 +884,14 @@ static const char* kPredictUsage =
     "TRACK_DIR (its forward progression rescaled to V). Writes the files of `gaitsim track`;\n"
     "summary.json adds stride time and length, their change from the guess, the cost of\n"
     "transport and peak triceps surae excitations. L-BFGS (Ipopt's limited-memory Hessian)\n"
-    "stops at Ipopt's optimal or acceptable level, or once the objective has settled: "
-    GO_STR(GO_SETTLE_ITER) " of\n"
-    "the last 2 x " GO_STR(GO_SETTLE_ITER) " iterations at a violation <= " GO_STR(GO_PREDICT_SETTLE_VIOL)
-    ", their objectives within " GO_STR(GO_SETTLE_REL) " relative per\n"
-    "iteration (status \"objective settled\"); then the polish onto the dynamics. Exit status 3\n"
-    "when the solver stopped short.\n\n"
+    "stops at Ipopt's optimal solution, at its acceptable level (" GO_STR(GO_SETTLE_ITER)
+    " consecutive iterations at a\n"
+    "violation <= " GO_STR(GO_PREDICT_SETTLE_VIOL) ", the objective changing <= "
+    GO_STR(GO_PREDICT_SETTLE_REL) " relative per iteration), or once " GO_STR(GO_SETTLE_ITER)
+    " of the\n"
+    "last 2 x " GO_STR(GO_SETTLE_ITER) " iterations meet it (status \"objective settled\"); "
+    "then the polish onto the\n"
+    "dynamics. Exit status 3 when the solver stopped short.\n\n"
     "  --model FILE        MJCF model (default: the one TRACK_DIR/summary.json names, else\n"
     "                      mjmodels/jw_fullbody_knee6.xml)\n"
     "  --nodes N           collocation nodes (default: the guess's, TRACK_DIR/summary.json\n"
@@ -953,6 +955,12 @@ int gs_cmd_predict(int argc, char** argv) {
                            // "Predictions: the metabolic Hessian and Newton")
   o.plan.max_iter = GO_MAX_ITER;
   o.plan.settle_main_viol = GO_PREDICT_SETTLE_VIOL;
+  o.plan.settle_main_rel = GO_PREDICT_SETTLE_REL;
+  {  // Ipopt's acceptable level at the same objective change (the caller's --ipopt comes later)
+    char why[128];
+    go_ipopt_opts_set(&o.plan.ipopt, "acceptable_obj_change_tol", GO_STR(GO_PREDICT_SETTLE_REL),
+                      why, sizeof(why));
+  }
   o.nodes = GO_NODES_PREDICT;
   o.w_effort = GO_PREDICT_W_EFFORT;
   o.w_accel = GO_PREDICT_W_ACCEL;

@@ -87,16 +87,19 @@
 #define GO_SETTLE_ITER 15
 #define GO_SETTLE_REL 1e-4
 #define GO_SETTLE_VIOL 1e-3
-// a prediction's main solve stops by the settled rule too (go_solve_plan.settle_main_viol), at
-// Ipopt's acceptable violation (scaled, -): GO_SETTLE_ITER iterations at inf_pr <= 1e-4 among
-// the last 2 GO_SETTLE_ITER whose objectives span <= GO_SETTLE_REL relative per iteration.
-// Ipopt's acceptable level asks for 15 consecutive such iterations, which the L-BFGS
-// violation's spikes (1e-3 - 1e-2 every few iterations) reset: in the main job at 80 nodes the
-// 0.8 m/s prediction's objective stayed within 0.5 % of its final value for its last 700 of
-// 1389 iterations, while the adaptive barrier wandered (mu 1e-7.4 - 1e-5.7); replayed on that
-// log the rule stops at iteration 677, and at 822 of 1098 on the 2.0 m/s one, within 0.4 % and
-// 0.01 % of the final objectives (docs/BENCHMARKS.md, "Predictions: the settled rule")
+// a prediction's stopping rule (gaitsim predict, sweep, run): Ipopt's acceptable level at a
+// violation of 1e-4 (scaled, -) with the objective changing <= GO_PREDICT_SETTLE_REL relative per
+// iteration (-) over GO_SETTLE_ITER consecutive iterations (acceptable_obj_change_tol), or the
+// settled rule at the same figures over GO_SETTLE_ITER of the last 2 GO_SETTLE_ITER
+// (go_solve_plan.settle_main_viol, settle_main_rel). L-BFGS's violation spikes (1e-3 - 1e-2
+// every few iterations) reset Ipopt's count: in the main job at 80 nodes the 0.8 m/s prediction's
+// objective stayed within 0.5 % of its final value for its last 700 of 1389 iterations while the
+// adaptive barrier wandered. With 1e-4 per iteration (Ipopt's and the track's) a prediction
+// stopped at iteration 405 on a stretch falling 5e-5 per iteration, at J 3.593, where another
+// run of the same solve, apart from rounding, went on to 3.511 (docs/BENCHMARKS.md,
+// "Predictions: one factorisation per L-BFGS iteration, and the settled rule")
 #define GO_PREDICT_SETTLE_VIOL 1e-4
+#define GO_PREDICT_SETTLE_REL 1e-5
 // feasibility polish (go_solve.h): Gauss-Newton iterations at most (-), and its wall-clock cap
 // after a stop signal (s)
 #define GO_POLISH_ITER 200

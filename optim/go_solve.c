@@ -65,6 +65,8 @@ void go_solve_plan_default(go_solve_plan* p) {
   p->settle_iter = GO_SETTLE_ITER;
   p->settle_rel = GO_SETTLE_REL;
   p->settle_viol = GO_SETTLE_VIOL;
+  p->settle_main_viol = 0;  // the main solve: Ipopt's tests alone (predictions set it)
+  p->settle_main_rel = GO_SETTLE_REL;
   p->polish = 1;
   p->polish_iter = GO_POLISH_ITER;
   p->stop_polish_wall_s = GO_STOP_POLISH_S;
@@ -487,7 +489,7 @@ static int run_stages(run_state* s, go_solve_report* rep, char* err, int errsz) 
   opts.hess = s->hess;
   if (p->settle_main_viol > 0) {
     opts.settle_iter = p->settle_iter;
-    opts.settle_rel = p->settle_rel;
+    opts.settle_rel = p->settle_main_rel;
     opts.settle_viol = p->settle_main_viol;
   }
   if (p->handover_iter > 0 && p->refine_iter > 0 && p->hessian == GO_HESSIAN_LBFGS) {

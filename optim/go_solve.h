@@ -94,8 +94,9 @@ typedef struct {
   double settle_rel;          // its relative objective change per iteration (-)
   double settle_viol;         // its violation (scaled, max norm, -)
   double settle_main_viol;    // > 0: the main solve and its restarts stop by the settled rule
-                              // too (settle_iter, settle_rel) at this violation (scaled, max
-                              // norm, -); 0: by Ipopt's tests alone
+                              // too (settle_iter of the last 2 settle_iter iterations) at this
+                              // violation (scaled, max norm, -); 0: by Ipopt's tests alone
+  double settle_main_rel;     // that rule's relative objective change per iteration (-)
   int polish;                 // 1: feasibility polish of the point chosen
   int polish_iter;            // polish iterations at most (-)
   double stop_polish_wall_s;  // polish's wall-clock cap after a stop signal (s)

@@ -20,10 +20,9 @@
 #define GO_MAX_ITER 2500           // each prediction: gaitsim predict, each speed of sweep and of
                                    // run's main job (--max-iter). An iteration budget, not a time
                                    // limit, so results do not depend on the load of the machine;
-                                   // at 80 nodes the main job's predictions reached Ipopt's
-                                   // acceptable level after 243 (0.8 m/s) and 882 (2.0 m/s)
-                                   // iterations; from another 80-node tracking solution 1450 and
-                                   // 811 (docs/BENCHMARKS.md)
+                                   // at 80 nodes the main job's predictions stop after 415
+                                   // (0.8 m/s) and 729 (2.0 m/s) iterations; other starts took
+                                   // up to 1450 (docs/BENCHMARKS.md)
 #define GO_MAX_ITER_TRACK 60       // track's main solve, Gauss-Newton from the trial's guess at
                                    // barrier GO_GN_MU_INIT, before the refinement (--max-iter).
                                    // At N = 80 it brings the violation from 182 to about 0.1 at
@@ -92,12 +91,12 @@
 // iteration (-) over GO_SETTLE_ITER consecutive iterations (acceptable_obj_change_tol), or the
 // settled rule at the same figures over GO_SETTLE_ITER of the last 2 GO_SETTLE_ITER
 // (go_solve_plan.settle_main_viol, settle_main_rel). L-BFGS's violation spikes (1e-3 - 1e-2
-// every few iterations) reset Ipopt's count: in the main job at 80 nodes the 0.8 m/s prediction's
+// every few iterations) reset Ipopt's count: in a main job at 80 nodes the 0.8 m/s prediction's
 // objective stayed within 0.5 % of its final value for its last 700 of 1389 iterations while the
-// adaptive barrier wandered. With 1e-4 per iteration (Ipopt's and the track's) a prediction
-// stopped at iteration 405 on a stretch falling 5e-5 per iteration, at J 3.593, where another
-// run of the same solve, apart from rounding, went on to 3.511 (docs/BENCHMARKS.md,
-// "Predictions: one factorisation per L-BFGS iteration, and the settled rule")
+// adaptive barrier wandered. 1e-5 rather than Ipopt's and the track's 1e-4: in the main job the
+// 2.0 m/s prediction stopped at iteration 536 with 1e-4 and at 729 with 1e-5, 0.11 % lower; the
+// 0.8 m/s one at 405 and 415, at the same point (docs/BENCHMARKS.md, "Predictions: one
+// factorisation per L-BFGS iteration, and the settled rule")
 #define GO_PREDICT_SETTLE_VIOL 1e-4
 #define GO_PREDICT_SETTLE_REL 1e-5
 // feasibility polish (go_solve.h): Gauss-Newton iterations at most (-), and its wall-clock cap

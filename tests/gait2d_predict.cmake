@@ -1,11 +1,12 @@
 # Slow end-to-end test of the predictive problem on the planar model (issue #5): mjmodels/gait2d.xml
 # (9 dof, 18 muscles) tracks the default trial's sagittal coordinates and ground reactions for
-# 100 Gauss-Newton iterations at 20 nodes (the guess, a few seconds), then `gaitsim predict` minimises the
-# cost of transport at 1.2 m/s with free stride time from it. Passes when predict converges by
-# the project's stopping rule (go_solve.c and GO_PREDICT_SETTLE_VIOL: Ipopt's optimal or acceptable
-# level, i.e. feasible to 1e-4 scaled and the objective settled to 1e-4 over 15 iterations, or the
-# settled rule, 15 of 30 such iterations, then polished onto the dynamics): exit 0, status optimal,
-# acceptable or settled, max violation <= 1e-6 (so after an acceptable
+# 100 Gauss-Newton iterations at 20 nodes (the guess, a few seconds), then `gaitsim predict`
+# minimises the cost of transport at 1.2 m/s with free stride time from it. Passes when predict
+# converges by the project's stopping rule for predictions (optim/go_defaults.h,
+# GO_PREDICT_SETTLE_VIOL and _REL: Ipopt's optimal solution, its acceptable level at a violation of
+# 1e-4 scaled with the objective changing <= 1e-5 over 15 consecutive iterations, or the settled
+# rule, 15 of 30 such iterations; then polished onto the dynamics): exit 0, status optimal,
+# acceptable or settled, max violation <= 1e-6 (so after such a
 # stop the polish must have worked), mean speed 1.2 m/s to 1e-6, stride time within 0.8-1.6 s,
 # a positive cost of transport, and the smooth cost of transport the solve minimises within 5 % of
 # the exact Umberger 2010 one of the same solution (summary.json cost_of_transport_exact_*: the

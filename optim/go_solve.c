@@ -32,7 +32,8 @@ void go_solve_plan_default(go_solve_plan* p) {
   // stopping rule (the caller's extra options come after and override it): Ipopt's own
   // optimality at tol 1e-4, or its acceptable level: violation <= 1e-4 (scaled; the polish then
   // projects the point onto the dynamics, to <= 1e-8) and the objective settled to 1e-4 relative
-  // per iteration over 15 consecutive iterations. With 1e-6 instead of 1e-4, the predictions at
+  // per iteration (gaitsim predict: GO_PREDICT_SETTLE_REL) over GO_SETTLE_ITER (15) consecutive
+  // iterations, the count of the settled rule. With 1e-6 instead of 1e-4, the predictions at
   // 0.8 and 2.0 m/s went on past their settled objective (within 0.1 % of the lowest ever
   // reached) and, in 2 of 4 solves, climbed back 40-50 % when the adaptive barrier fell back to
   // its monotone mode (docs/BENCHMARKS.md, "The acceptable level at 1e-4").
@@ -40,15 +41,16 @@ void go_solve_plan_default(go_solve_plan* p) {
       {"tol", "1e-4"},          {"constr_viol_tol", "1e-6"},
       {"acceptable_tol", "1"},  {"acceptable_constr_viol_tol", "1e-4"},
       {"acceptable_compl_inf_tol", "1e-3"}, {"acceptable_obj_change_tol", "1e-4"},
-      {"acceptable_iter", "15"}, {"limited_memory_max_history", "20"}};
+      {"acceptable_iter", GO_STR(GO_SETTLE_ITER)}, {"limited_memory_max_history", "20"}};
   for (size_t i = 0; i < sizeof(stop_rule) / sizeof(stop_rule[0]); i++)
     go_ipopt_opts_set(&p->ipopt, stop_rule[i][0], stop_rule[i][1], err, sizeof(err));
   // the limited-memory Hessian's KKT systems: one factorisation of the augmented system extended
   // by the 2 x 20 low-rank columns, instead of Ipopt's default Sherman-Morrison update, which
   // re-solves the system for each of those columns at every iteration (the barrier diagonal
   // changes the factor each time). At N = 80 the 40 back-solves took 57 % of an L-BFGS
-  // iteration; extended, a prediction's iteration costs 0.96 s instead of 1.5 s on one core
-  // (docs/BENCHMARKS.md, "The L-BFGS phase: the low-rank back-solves")
+  // iteration; extended, a prediction's iteration costs about 1.0 s instead of 1.6 s on one core
+  // (docs/BENCHMARKS.md, "Predictions: one factorisation per L-BFGS iteration, and the settled
+  // rule")
   go_ipopt_opts_set(&p->ipopt, "limited_memory_aug_solver", "extended", err, sizeof(err));
   // fall-back guard: stop when the objective rises GO_FALLBACK_RISE above the lowest one
   // reached at a violation <= GO_FALLBACK_VIOL, and restart from the best iterate

@@ -8,6 +8,8 @@
 #include <stdlib.h>
 #include <string.h>
 #include <errno.h>
+#include <signal.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "app/gs_app_model.h"
@@ -68,6 +70,43 @@ static int sub(gsCommandFn fn, const char* const* words) {
   int rc = fn(argc, argv);
   free(argv);
   return rc;
+}
+
+// run one solve step in a process of its own, so that every solve starts from the state of a
+// fresh process, as the same solve run by its own command does: the tracking solve leaves
+// state behind in the process (allocations, library buffers) that changed a later prediction's
+// rounding from its 9th digit on (docs/BENCHMARKS.md, "One process per solve step"). Stop
+// signals are passed on to the step's process, which writes what it holds.
+static int sub_in_child(gsCommandFn fn, const char* const* words) {
+  fflush(stdout);
+  fflush(stderr);
+  sigset_t stops, before;
+  sigemptyset(&stops);
+  sigaddset(&stops, SIGINT);
+  sigaddset(&stops, SIGTERM);
+  sigaddset(&stops, SIGHUP);
+  sigprocmask(SIG_BLOCK, &stops, &before);  // held back until the child is registered
+  pid_t pid = fork();
+  if (pid > 0) go_ipopt_forward_signals_to((long)pid, 1);
+  sigprocmask(SIG_SETMASK, &before, NULL);
+  if (pid == 0) {
+    int rc = sub(fn, words);
+    fflush(stdout);
+    fflush(stderr);
+    _exit(rc);
+  }
+  if (pid < 0) {
+    fprintf(stderr, "gaitsim: run: fork: %s\n", strerror(errno));
+    return GS_EXIT_FAILURE;
+  }
+  int st = 0;
+  while (waitpid(pid, &st, 0) < 0 && errno == EINTR) {
+  }
+  go_ipopt_forward_signals_to((long)pid, 0);
+  if (WIFEXITED(st)) return WEXITSTATUS(st);
+  fprintf(stderr, "gaitsim: run: %s step ended by signal %d\n", words[0],
+          WIFSIGNALED(st) ? WTERMSIG(st) : 0);
+  return GS_EXIT_FAILURE;
 }
 
 // after a stop signal: say what is kept, 1; else 0
@@ -165,7 +204,7 @@ int gs_cmd_run(int argc, char** argv) {
   printf("[1] tracking solve of %s, %s nodes -> %s\n", trial, nodes, track);
   const char* w1[] = {"track", trial, "--out", track, "--nodes", nodes, "--threads", threads,
                       NULL};
-  rc = sub(gs_cmd_track, w1);
+  rc = sub_in_child(gs_cmd_track, w1);
   if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
   stopped_short |= rc == GS_EXIT_STOPPED_SHORT;
   if (stopped_by_signal(out)) return GS_EXIT_STOPPED_SHORT;
@@ -179,7 +218,7 @@ int gs_cmd_run(int argc, char** argv) {
   const char* w3[] = {"sweep", "--guess", track, "--speeds", speeds, "--out", sweep_dir,
                       "--nodes", nodes, "--max-iter", max_iter,
                       max_time ? "--max-time" : NULL, max_time, NULL};
-  rc = sub(gs_cmd_sweep, w3);
+  rc = sub_in_child(gs_cmd_sweep, w3);
   if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
   stopped_short |= rc == GS_EXIT_STOPPED_SHORT;
   if (stopped_by_signal(out)) return GS_EXIT_STOPPED_SHORT;

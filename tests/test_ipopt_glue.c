@@ -156,6 +156,11 @@ int main(void) {
   EXPECT_EQ_INT(0, solve(nlp, &o, z, zb, NULL, &r, &rc, err));
   double j_tight = r.objective;
   int it_tight = r.iterations;
+  // at tol 1e-12 Ipopt ends at its optimal solution or, where the CPU's rounding keeps the
+  // last iterations from 1e-12, at its acceptable level (both seen); the runs below where the
+  // rules never fire must end as this one did
+  int st_tight = r.status;
+  EXPECT_TRUE(st_tight == GO_SOLVE_SUCCESS || st_tight == GO_SOLVE_ACCEPTABLE);
   o.settle_iter = 3;
   o.settle_rel = 1e-2;
   o.settle_viol = 1e10;
@@ -169,7 +174,7 @@ int main(void) {
   o.settle_viol = 1e-30;
   guess(z);
   EXPECT_EQ_INT(0, solve(nlp, &o, z, zb, NULL, &r, &rc, err));
-  EXPECT_EQ_INT(GO_SOLVE_SUCCESS, r.status);
+  EXPECT_EQ_INT(st_tight, r.status);
   EXPECT_EQ_INT(it_tight, r.iterations);
   EXPECT_NEAR(j_tight, r.objective, 1e-12);
 
@@ -187,7 +192,7 @@ int main(void) {
   o.handover_viol = 1e-30;
   guess(z);
   EXPECT_EQ_INT(0, solve(nlp, &o, z, zb, NULL, &r, &rc, err));
-  EXPECT_EQ_INT(GO_SOLVE_SUCCESS, r.status);
+  EXPECT_EQ_INT(st_tight, r.status);
   EXPECT_EQ_INT(it_tight, r.iterations);
 
   // ./ipopt.opt in the working directory is not read (it would stop after 1 iteration and print)

@@ -954,13 +954,7 @@ int gs_cmd_predict(int argc, char** argv) {
   o.plan.refine_iter = 0;  // Newton after L-BFGS settles at a higher cost (docs/BENCHMARKS.md,
                            // "Predictions: the metabolic Hessian and Newton")
   o.plan.max_iter = GO_MAX_ITER;
-  o.plan.settle_main_viol = GO_PREDICT_SETTLE_VIOL;
-  o.plan.settle_main_rel = GO_PREDICT_SETTLE_REL;
-  {  // Ipopt's acceptable level at the same objective change (the caller's --ipopt comes later)
-    char why[128];
-    go_ipopt_opts_set(&o.plan.ipopt, "acceptable_obj_change_tol", GO_STR(GO_PREDICT_SETTLE_REL),
-                      why, sizeof(why));
-  }
+  go_solve_plan_settle_main(&o.plan, GO_PREDICT_SETTLE_VIOL, GO_PREDICT_SETTLE_REL);
   o.nodes = GO_NODES_PREDICT;
   o.w_effort = GO_PREDICT_W_EFFORT;
   o.w_accel = GO_PREDICT_W_ACCEL;

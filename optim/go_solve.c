@@ -75,6 +75,14 @@ void go_solve_plan_default(go_solve_plan* p) {
   p->label = "solve";
 }
 
+void go_solve_plan_settle_main(go_solve_plan* p, double viol, double rel) {
+  char val[32], err[256];
+  p->settle_main_viol = viol;
+  p->settle_main_rel = rel;
+  snprintf(val, sizeof(val), "%g", rel);
+  go_ipopt_opts_set(&p->ipopt, "acceptable_obj_change_tol", val, err, sizeof(err));
+}
+
 void go_solve_report_free(go_solve_report* r) {
   free(r->z);
   r->z = NULL;

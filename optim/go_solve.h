@@ -149,6 +149,12 @@ typedef struct {
 // no limits, no progress; gait and z0 NULL.
 void go_solve_plan_default(go_solve_plan* plan);
 
+// The main solve (and its restarts) also stops by the settled rule at violation viol (scaled,
+// max norm, -) and relative objective change rel per iteration (-), and Ipopt's acceptable
+// level asks the same change (acceptable_obj_change_tol rel; extra options the caller adds
+// later still override it). gaitsim predict: GO_PREDICT_SETTLE_VIOL, GO_PREDICT_SETTLE_REL.
+void go_solve_plan_settle_main(go_solve_plan* plan, double viol, double rel);
+
 // Run the plan. 0 with *report filled (the solve's outcome is report->result.status), or -1
 // with the reason in err (a solve could not start, out of memory); report->z is then NULL.
 int go_solve_run(const go_solve_plan* plan, go_solve_report* report, char* err, int errsz);

@@ -29,9 +29,12 @@ Usage (after building gaitsim; about 30 s):
   /usr/bin/python3 scripts/make_stock_model.py [--source mjmodels/jw_fullbody.xml]
       [--hill-model mjmodels/jw_fullbody_knee6.xml] [--trial mjmodels/trials/jw_ngait_og5]
       [--poses mjmodels/reference/jw_poses.csv] [--gaitsim build/gaitsim]
-      [--out mjmodels/jw_fullbody_mujoco.xml]
+      [--out mjmodels/jw_fullbody_mujoco.xml | --check mjmodels/jw_fullbody_mujoco.xml]
 Python standard library + python3-numpy/scipy; runs build/gaitsim and mujoco-compile
-(libmujoco-samples). Deterministic output, written atomically.
+(libmujoco-samples). Output written atomically; the same on one machine run after run, while the
+muscle fits' last digits (and, for a poorly determined muscle, its local minimum) move between
+machines with their floating point: --check therefore asks every committed muscle to fit
+gaitsim's forces within CHECK_RMS_TOL of this run's fit and everything else to be equal.
 """
 import argparse
 import math
@@ -55,6 +58,11 @@ ACT_SMOOTHING = 10.0
 # gsActUser / gsGeomUser indices (callbacks/gs_model_layout.h)
 U_FMAX, U_LOPT, U_LTS, U_PENN, U_VMAX, U_TAU_ACT, U_TAU_DEACT = 0, 1, 2, 3, 4, 9, 10
 G_E, G_C, G_MUS, G_MUD = 0, 1, 2, 3
+
+# --check: muscle attributes set by the non-convex fit, and how much worse (RMS / Fmax, -) a
+# committed muscle may fit gaitsim's forces than this run's fit does
+CHECK_FITTED = ("force", "range", "lmin", "lmax", "fpmax", "vmax")
+CHECK_RMS_TOL = 0.005
 
 # contact fit: penetration grid (m) and the depth at which the damping is matched (m)
 DEPTHS = np.geomspace(0.002, 0.015, 40)
@@ -273,6 +281,48 @@ def fit_muscle(lmt, force, fmax, lopt, lnorm, lmt_min):
     return best
 
 
+def muscle_fit_rms(el, lmt, force, fmax, lopt):
+    """RMS difference / Fmax between the MuJoCo muscle el (its force, range, lengthrange, lmin,
+    lmax, fpmax as written) and gaitsim's forces (A x P) at lengths lmt (P), as fit_muscle's."""
+    get = lambda k: [float(v) for v in el.get(k).split()]
+    lr, rng = get("lengthrange"), get("range")
+    L = rng[0] + (lmt - lr[0]) * (rng[1] - rng[0]) / (lr[1] - lr[0])
+    lmin, lmax, fpmax = float(el.get("lmin")), float(el.get("lmax")), float(el.get("fpmax"))
+    acts = np.array(ACTIVATIONS)[:, None]
+    model = float(el.get("force")) / fmax * (acts * mj_fl(L[None, :].repeat(len(ACTIVATIONS), 0),
+                                                          lmin, lmax) + mj_fp(L, lmax, fpmax))
+    return math.sqrt(np.mean((model - force / fmax) ** 2))
+
+
+def check_model(committed, generated, lmt, force, fits):
+    """Compare a committed stock model (element tree) with the one this run generated. Every
+    element, attribute and value must be equal, except the fitted muscle attributes (CHECK_FITTED)
+    and the header comment: the muscle fits are non-convex least squares whose local minimum
+    moves with the machine's floating point (OpenBLAS kernels, libm), so each committed muscle
+    must instead fit gaitsim's forces at most CHECK_RMS_TOL worse than this run's fit. Returns
+    ((largest excess, muscle), reason or None)."""
+    a, b = list(committed.iter()), list(generated.iter())
+    if len(a) != len(b):
+        return (0.0, ""), f"{len(a)} elements, this run writes {len(b)}"
+    worst, k = (-math.inf, ""), 0
+    for ea, eb in zip(a, b):
+        if ea.tag != eb.tag or set(ea.attrib) != set(eb.attrib):
+            return worst, f"element {ea.tag} {ea.get('name', '')} differs in tag or attribute names"
+        fitted = CHECK_FITTED if ea.tag == "muscle" else ()
+        for key, val in eb.attrib.items():
+            if key not in fitted and ea.get(key) != val:
+                return worst, f"{ea.tag} {ea.get('name', '')}: {key}=\"{ea.get(key)}\", " \
+                              f"this run writes \"{val}\""
+        if ea.tag == "muscle":
+            u = user_row(ea, None, 12)
+            excess = muscle_fit_rms(ea, lmt[:, k], force[:, :, k], u[U_FMAX], u[U_LOPT]) - fits[k]
+            worst = max(worst, (excess, ea.get("name")))
+            k += 1
+    if worst[0] > CHECK_RMS_TOL:
+        return worst, f"muscle {worst[1]} fits gaitsim {worst[0]:.4f} worse than this run"
+    return worst, None
+
+
 def fit_contact_shape():
     """solimp (dmin, dmax, width, mid 0.5, power) and K1 such that
     mj_static_force(d, K1 E sqrt(R) A, A, solimp) ~ 4/3 E sqrt(R) d^1.5 for d in DEPTHS: the
@@ -313,7 +363,15 @@ def main():
     ap.add_argument("--poses", default="mjmodels/reference/jw_poses.csv")
     ap.add_argument("--gaitsim", default="build/gaitsim")
     ap.add_argument("--out", default="mjmodels/jw_fullbody_mujoco.xml")
+    ap.add_argument("--check", metavar="FILE",
+                    help="write nothing; exit 1 unless FILE is what this run would write, up to "
+                         "the fit's reproducibility (check_model)")
     args = ap.parse_args()
+    if args.check:
+        try:
+            committed = ET.parse(args.check).getroot()
+        except (OSError, ET.ParseError) as e:
+            raise PrepError(args.check, f"cannot read: {e}")
 
     tree = ET.parse(args.source)
     root = tree.getroot()
@@ -440,10 +498,9 @@ def main():
     header = f"""<?xml version="1.0" encoding="utf-8"?>
 <!--
   jw_fullbody_mujoco.xml: GENERATED by scripts/make_stock_model.py, do not edit by hand;
-  regenerate (after building gaitsim) with
-    /usr/bin/python3 scripts/make_stock_model.py --source {args.source}
-        --hill-model {args.hill_model} --trial {args.trial}
-        --poses {args.poses}
+  regenerate (after building gaitsim) with /usr/bin/python3 scripts/make_stock_model.py and
+    its options source {args.source}, hill-model {args.hill_model},
+    trial {args.trial}, poses {args.poses}
   Sources: {args.source} (its header: converted by scripts/osim2mjcf.py from
     JW_AllBody_scaled.osim, gilserrancoli/ReducePoly_forMSK, MIT licence; Knee Grand Challenge
     subject JW, Fregly et al. 2012) and gaitsim's physics on {args.hill_model}.
@@ -471,6 +528,15 @@ def main():
     (a 1-DOF knee in effect); gaitsim's implant-knee surrogate is not represented.
 -->
 """
+    if args.check:
+        worst_excess, why = check_model(committed, root, lmt, force, fits)
+        verdict = "differs" if why else "matches"
+        print(f"make_stock_model: {args.check} {verdict}: {why or 'structure and attributes equal'}"
+              f"; largest fit RMS/Fmax above this run's {worst_excess[0]:.4f} ({worst_excess[1]}, "
+              f"tolerance {CHECK_RMS_TOL})")
+        if why:
+            sys.exit(1)
+        return
     write_atomic(args.out, header + body_xml + "\n")
     print(f"make_stock_model: wrote {args.out}: {len(names)} muscles, RMS/Fmax median "
           f"{np.median(fit_rms):.3f}, max {worst[0]:.3f} ({worst[1]}); {npose} poses; "

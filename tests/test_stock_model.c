@@ -12,9 +12,12 @@
 //      collision geom more than 2 cm below the floor, the secondary right-knee coordinates within
 //      physiological ranges of standing (anterior-posterior knee_tx 10 mm, as an anterior drawer;
 //      knee_ty and knee_tz 5 mm; adduction 5 deg; rotation 10 deg), no MuJoCo warning, finite
-//      state; and 1 s more: the body rests on the floor (at 3 s the contacts' vertical force is
-//      body weight within 5 % and no speed exceeds 0.5 m/s or rad/s; measured 0.15), still no
-//      geom 2 cm below the floor.
+//      state; and 4 s more: the body rests on the floor (at 6 s the contacts' vertical force is
+//      body weight within 5 % and no speed exceeds 0.5 m/s or rad/s; measured 0.02), still no
+//      geom 2 cm below the floor. The collapse is chaotic: how the limbs fold and when they stop
+//      moves with the muscle fits' last digits, which differ between machines
+//      (scripts/make_stock_model.py); from 3 s to 6 s the largest speed of two such fits fell
+//      from 0.15 and 1.5 to 0.02 and 0.02, so the rest is checked at 6 s.
 #include <math.h>
 #include <mujoco/mujoco.h>
 #include <stdio.h>
@@ -46,7 +49,7 @@
 #define KNEE_ADD_TOL 0.0873   // knee_adduction from standing (rad, 5 deg)
 #define KNEE_ROT_TOL 0.1745   // knee_rotation from standing (rad, 10 deg)
 #define DROP_TIME 2.0         // checked span of the drop (s)
-#define REST_TIME 3.0         // time by which the body rests (s)
+#define REST_TIME 6.0         // time by which the body rests (s)
 #define REST_FORCE_TOL 0.05   // vertical contact force at rest, relative to body weight (-)
 #define REST_SPEED_TOL 0.5    // largest |qvel| at rest (m/s or rad/s)
 

@@ -106,6 +106,39 @@ def tracking(track):
         print()
 
 
+def cost_across_speeds(sums):
+    """Issue #20 item 4's checks on the predictions' metabolic cost across speeds."""
+    pts = [(s["speed_target_mps"], s["cost_of_transport_j_per_kg_m"]) for s in sums
+           if s.get("speed_target_mps") and s.get("cost_of_transport_j_per_kg_m") is not None]
+    if len(pts) < 2:
+        return
+    v = [p[0] for p in pts]
+    net = [p[0] * p[1] for p in pts]
+    gross_cot = [(n + BASAL_W_PER_KG) / x for n, x in zip(net, v)]
+    ral_cot = [ralston_gross_w_per_kg(x) / x for x in v]
+    by = {round(x, 1): c for x, c in pts}
+    kmin = min(range(len(v)), key=lambda k: gross_cot[k])
+    kral = min(range(len(v)), key=lambda k: ral_cot[k])
+    print("Cost across speeds (#20 item 4): gross cost of transport = (net power + basal "
+          f"{BASAL_W_PER_KG} W/kg) / speed, beside Ralston 1958's.\n")
+    row(["check", "model", "target", "met"])
+    row(["---"] * 4)
+    rises = all(b > a for a, b in zip(net, net[1:]))
+    row(["net power by speed (W/kg)", ", ".join(f"{fmt(x, 1)}: {fmt(n)}" for x, n in zip(v, net)),
+         "rises at every step", "yes" if rises else "no"])
+    if 1.2 in by and 2.0 in by:
+        row(["net CoT 2.0 against 1.2 m/s (J/(kg m))", f"{fmt(by[2.0])} against {fmt(by[1.2])}",
+             "2.0 higher", "yes" if by[2.0] > by[1.2] else "no"])
+    u_shape = 0 < kmin < len(v) - 1 and 1.0 <= v[kmin] <= 1.6
+    row(["gross CoT by speed (J/(kg m)); Ralston's",
+         ", ".join(f"{fmt(x, 1)}: {fmt(g)}" for x, g in zip(v, gross_cot)) +
+         "; " + ", ".join(f"{fmt(x, 1)}: {fmt(r)}" for x, r in zip(v, ral_cot)),
+         "U-shaped, minimum at 1.0-1.6 m/s",
+         ("yes" if u_shape else "no") + f" (model's minimum at {fmt(v[kmin], 1)} m/s, "
+         f"Ralston's at {fmt(v[kral], 1)})"])
+    print()
+
+
 def predictions(folders):
     sums = []
     for f in folders:
@@ -143,6 +176,7 @@ def predictions(folders):
              f"{fmt(kr)} / {fmt(kl)}",
              "-" if lim is None else ("yes" if max(kr, kl) <= lim else "no")])
     print()
+    cost_across_speeds(sums)
     by = {round(s.get("speed_target_mps", 0), 1): s for s in sums}
     if 0.8 in by and 2.0 in by:
         pe0, pe1 = by[0.8].get("peak_excitation", {}), by[2.0].get("peak_excitation", {})

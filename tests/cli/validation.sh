@@ -3,7 +3,9 @@
 # whose feet stand at z = 0.25 / 0.10 m and a tracking solution at 0.30 / 0.05 m (stance width
 # 15.0 against 25.0 cm: +10.0, missed); Table 1 rows compared with the paper's participant 2;
 # predictions at 0.8 and 2.0 m/s with Ralston's gross rate (29 + 0.0053 v^2 cal/(kg min), v in
-# m/min: 2.87 and 7.34 W/kg) and the fast/slow soleus ratio (0.6 / 0.3 = 2.00); a missing
+# m/min: 2.87 and 7.34 W/kg) and the fast/slow soleus ratio (0.6 / 0.3 = 2.00), and issue 20
+# item 4's checks across 0.8, 1.2 and 2.0 m/s (net power 2.00, 2.64, 7.00 W/kg rising; gross CoT
+# (net + 1.2) / v 4.00, 3.20, 4.10 J/(kg m), lowest at 1.2 m/s: U-shaped); a missing
 # track summary exits 1 with one line naming the file.
 # usage: validation.sh GAITSIM SOURCE_DIR
 set -u
@@ -25,7 +27,8 @@ json.dump({"problem": "tracking", "trial": "trial", "nodes": 80, "status": "opti
                    "grf_ml_bw": 0.03, "joint_rot_deg": 2.5, "knee_contact_bw": 0.24,
                    "knee_medial_bw": 0.29, "knee_lateral_bw": 0.31}},
           open("results/track/summary.json", "w"))
-for v, T, cot, kr, kl, sol in ((0.8, 1.40, 2.5, 2.7, 2.9, 0.3), (2.0, 0.95, 3.5, 3.0, 3.2, 0.6)):
+for v, T, cot, kr, kl, sol in ((0.8, 1.40, 2.5, 2.7, 2.9, 0.3), (1.2, 1.10, 2.2, 2.5, 2.5, 0.4),
+                               (2.0, 0.95, 3.5, 3.0, 3.2, 0.6)):
     d = f"results/sweep/predict_{v:g}"
     os.makedirs(d)
     json.dump({"problem": "prediction", "speed_target_mps": v, "nodes": 80,
@@ -47,6 +50,9 @@ check "0.8 m/s row" grep -qF "| 0.8 | 80, optimal solution found | 1.400 (-3.4 %
 # 2.0 m/s: net 7.00, gross 8.20 against 7.34 (+12 %)
 check "2.0 m/s row" grep -qF "| 2.0 | 80, optimal solution found | 0.950 (+2.2 % of measured) | 0.92 / 0.93 | 3.50 | 7.00 | 8.20 | 7.34 | yes | 3.00 / 3.20 | yes |" <<<"$out"
 check "soleus ratio 2.00" grep -qF "soleus 2.00" <<<"$out"
+check "net power rises" grep -qF "| net power by speed (W/kg) | 0.8: 2.00, 1.2: 2.64, 2.0: 7.00 | rises at every step | yes |" <<<"$out"
+check "CoT 2.0 above 1.2" grep -qF "| net CoT 2.0 against 1.2 m/s (J/(kg m)) | 3.50 against 2.20 | 2.0 higher | yes |" <<<"$out"
+check "gross CoT U-shaped" grep -qF "0.8: 4.00, 1.2: 3.20, 2.0: 4.10; 0.8: 3.59, 1.2: 3.28, 2.0: 3.67 | U-shaped, minimum at 1.0-1.6 m/s | yes (model's minimum at 1.2 m/s, Ralston's at 1.2) |" <<<"$out"
 
 rm results/track/summary.json
 err=$(/usr/bin/python3 "$src/scripts/validation.py" results 2>&1 >/dev/null)

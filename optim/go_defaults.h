@@ -112,7 +112,8 @@
 #define GO_TRACK_W_GRF 10
 #define GO_TRACK_W_GRM 0     // off: 10 narrows the stance to the measured one but, at 600
                              // iterations, worsens pelvis, GRF and knee tracking
-                             // (docs/BENCHMARKS.md, 2026-12-02)
+                             // (docs/BENCHMARKS.md, "Foot placement and the
+                             // centre-of-pressure goal")
 #define GO_TRACK_W_EFFORT 50  // 0.1 left mean activation at 0.37 (co-contraction); issue #6 note
 #define GO_TRACK_W_ACCEL 0    // none (results stay as they were)
 // gaitsim predict's regularisation weights (-): effort, the mean squared excitation; accel, the
@@ -127,7 +128,8 @@
 // prediction reached Ipopt's stopping test in up to 1500 L-BFGS iterations; 10 times wider, 0.8
 // m/s reached the acceptable level after 477 and 2.0 m/s the optimal solution after 993 from the
 // same tracking solution, and the exact (unsmoothed) cost of transport of the solution differs by
-// 1.8 % (docs/BENCHMARKS.md, 2026-12-02); 3 times wider did not converge in 1000 at 0.8 m/s
+// 1.8 % (docs/BENCHMARKS.md, "Wider metabolic smoothing: the predictions converge"); 3 times
+// wider did not converge in 1000 at 0.8 m/s
 #define GO_PREDICT_METABOLIC_SMOOTHING 10
 // gaitsim predict's floor on the summed vertical ground reaction of both feet at every node
 // (BW): no flight phase. Not in the paper; without it, 20-node solves at 2.0 m/s found a gait

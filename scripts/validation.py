@@ -106,6 +106,15 @@ def tracking(track):
         print()
 
 
+def fit_ralston_form(v, power):
+    """(a, b) of power = a + b v^2 by least squares (W/kg, v in m/s)."""
+    n, x = len(v), [x * x for x in v]
+    sx, sy = sum(x), sum(power)
+    sxx, sxy = sum(t * t for t in x), sum(t * y for t, y in zip(x, power))
+    b = (n * sxy - sx * sy) / (n * sxx - sx * sx)
+    return (sy - b * sx) / n, b
+
+
 def cost_across_speeds(sums):
     """Issue #20 item 4's checks on the predictions' metabolic cost across speeds."""
     pts = [(s["speed_target_mps"], s["cost_of_transport_j_per_kg_m"]) for s in sums
@@ -137,6 +146,14 @@ def cost_across_speeds(sums):
          ("yes" if u_shape else "no") + f" (model's minimum at {fmt(v[kmin], 1)} m/s, "
          f"Ralston's at {fmt(v[kral], 1)})"])
     print()
+    if len(v) >= 3:
+        a, b = fit_ralston_form(v, [n + BASAL_W_PER_KG for n in net])
+        a_r, b_r = ralston_gross_w_per_kg(0.0), ralston_gross_w_per_kg(1.0) - \
+            ralston_gross_w_per_kg(0.0)
+        print(f"The model's gross power in Ralston's form, least squares over {len(v)} speeds: "
+              f"{a:.2f} + {b:.2f} v^2 W/kg (v in m/s), Ralston's {a_r:.2f} + {b_r:.2f} v^2: the "
+              "first term is the cost per second whatever the speed, the second the cost that "
+              "grows with speed.\n")
 
 
 def predictions(folders):

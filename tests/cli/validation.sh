@@ -5,7 +5,9 @@
 # predictions at 0.8 and 2.0 m/s with Ralston's gross rate (29 + 0.0053 v^2 cal/(kg min), v in
 # m/min: 2.87 and 7.34 W/kg) and the fast/slow soleus ratio (0.6 / 0.3 = 2.00), and issue 20
 # item 4's checks across 0.8, 1.2 and 2.0 m/s (net power 2.00, 2.64, 7.00 W/kg rising; gross CoT
-# (net + 1.2) / v 4.00, 3.20, 4.10 J/(kg m), lowest at 1.2 m/s: U-shaped); a missing
+# (net + 1.2) / v 4.00, 3.20, 4.10 J/(kg m), lowest at 1.2 m/s: U-shaped; gross power 3.20,
+# 3.84, 8.20 W/kg in Ralston's form a + b v^2 by least squares: 1.96 + 1.54 v^2, Ralston's
+# 29 cal/(kg min) = 2.02 W/kg + 0.0053 x 3600 cal/(kg min) = 1.33 W/kg per (m/s)^2); a missing
 # track summary exits 1 with one line naming the file.
 # usage: validation.sh GAITSIM SOURCE_DIR
 set -u
@@ -52,6 +54,7 @@ check "2.0 m/s row" grep -qF "| 2.0 | 80, optimal solution found | 0.950 (+2.2 %
 check "soleus ratio 2.00" grep -qF "soleus 2.00" <<<"$out"
 check "net power rises" grep -qF "| net power by speed (W/kg) | 0.8: 2.00, 1.2: 2.64, 2.0: 7.00 | rises at every step | yes |" <<<"$out"
 check "CoT 2.0 above 1.2" grep -qF "| net CoT 2.0 against 1.2 m/s (J/(kg m)) | 3.50 against 2.20 | 2.0 higher | yes |" <<<"$out"
+check "Ralston's form" grep -qF "3 speeds: 1.96 + 1.54 v^2 W/kg (v in m/s), Ralston's 2.02 + 1.33 v^2" <<<"$out"
 check "gross CoT U-shaped" grep -qF "0.8: 4.00, 1.2: 3.20, 2.0: 4.10; 0.8: 3.59, 1.2: 3.28, 2.0: 3.67 | U-shaped, minimum at 1.0-1.6 m/s | yes (model's minimum at 1.2 m/s, Ralston's at 1.2) |" <<<"$out"
 
 rm results/track/summary.json

@@ -7,4 +7,4 @@ add_test(NAME cli_export
 set_tests_properties(cli_export PROPERTIES LABELS cli TIMEOUT 120)
 add_test(NAME cli_export_viewer
   COMMAND bash ${CMAKE_CURRENT_SOURCE_DIR}/export/viewer.sh $<TARGET_FILE:gaitsim> ${CMAKE_SOURCE_DIR})
-set_tests_properties(cli_export_viewer PROPERTIES LABELS cli TIMEOUT 120 SKIP_RETURN_CODE 77)
+set_tests_properties(cli_export_viewer PROPERTIES LABELS cli TIMEOUT 240 SKIP_RETURN_CODE 77)

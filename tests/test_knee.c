@@ -550,13 +550,33 @@ static void* cache_worker(void* arg) {
   return NULL;
 }
 
+// A fresh copy of a model is not registered, unless the allocator placed it where an equal model
+// was registered and then freed (test_fixture's copies of the same model are): the cache then
+// keeps that entry, which must describe the copy exactly, pointers into it included.
+static void expect_unregistered_or_same(const mjModel* m) {
+  char err[300];
+  gsKneeModel km;
+  const gsKneeModel* e = gs_knee_lookup(m);
+  EXPECT_EQ_INT(1, gs_knee_model_init(m, &km, err, sizeof(err)));
+  if (!e) {
+    return;
+  }
+  EXPECT_TRUE(e->elem[0] == km.elem[0] && e->elem[1] == km.elem[1] && e->lig == km.lig);
+  EXPECT_TRUE(e->nelem[0] == km.nelem[0] && e->nelem[1] == km.nelem[1] && e->nlig == km.nlig);
+  EXPECT_TRUE(e->body_fem == km.body_fem && e->body_tib == km.body_tib);
+  for (int i = 0; i < 6; i++) {
+    EXPECT_TRUE(e->jnt[i] == km.jnt[i] && e->qadr[i] == km.qadr[i] && e->dadr[i] == km.dadr[i]);
+  }
+  EXPECT_NEAR(km.k_over_h, e->k_over_h, 0.0);
+}
+
 static void test_cache(const mjModel* m0) {
   char err[300];
   mjModel* m = mj_copyModel(NULL, m0);
   mjData* d = mj_makeData(m);
   const gsKneeModel* km_reg;
   gsKneeModel km;
-  EXPECT_TRUE(gs_knee_lookup(m) == NULL);
+  expect_unregistered_or_same(m);
   EXPECT_EQ_INT(1, gs_knee_model_init(m, &km, err, sizeof(err)));
 
   // a loaded pose with velocities: contact, ligaments and damping all act
@@ -588,7 +608,7 @@ static void test_cache(const mjModel* m0) {
   EXPECT_EQ_INT(1, gs_knee_register(m, err, sizeof(err)));
   EXPECT_TRUE(gs_knee_lookup(m) != NULL);
   mjModel* copy = mj_copyModel(NULL, m);
-  EXPECT_TRUE(gs_knee_lookup(copy) == NULL);
+  expect_unregistered_or_same(copy);
 
   // a cached number changed in place (the medial gain, gs_knee_femur header index 12): the entry
   // no longer matches, the next call re-registers and uses the new number

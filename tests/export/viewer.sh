@@ -6,7 +6,10 @@
 # spread >= 50: the model's orange contact spheres and red muscle paths on a grey floor and sky;
 # measured 1884, the empty model 0); the same window on an empty model must hold fewer than 20,
 # so a window where nothing is drawn, or whose menus stayed up, fails. The viewer is started up
-# to three times when GLFW cannot open its window (seen once in a few runs under load).
+# to three times when GLFW cannot open its window (seen once in a few runs under load). The keys
+# go once the window draws and the grab waits, polling up to 30 s, for the count to fall below a
+# quarter of the menus' (measured 191139 with menus, 1459 without): on a loaded machine a fixed
+# 3 s once grabbed both windows before they had acted on the keys (450155 pixels each).
 # Exit 77 (CTest: skipped), with a SKIPPED line, when Xvfb cannot start on this machine.
 # usage: viewer.sh GAITSIM SOURCE_DIR
 set -u
@@ -44,6 +47,25 @@ if [ ! -s display.txt ]; then
 fi
 export DISPLAY=:$(head -n 1 display.txt) LIBGL_ALWAYS_SOFTWARE=1
 
+# coloured pixels of window WIN now (xwd into NAME.xwd)
+grab() {
+  xwd -id "$1" -silent >"$2.xwd" || { echo 0; return; }
+  /usr/bin/python3 - "$2.xwd" <<'PY'
+import sys
+import numpy as np
+d = open(sys.argv[1], "rb").read()
+h = np.frombuffer(d[:100], ">u4")  # XWD header: 25 big-endian words
+size, w, hgt, order, bpp, stride, ncolors = h[0], h[4], h[5], h[7], h[11], h[12], h[19]
+masks = h[14:17]
+assert bpp == 32, "expected 32 bits per pixel"
+pix = np.frombuffer(d[size + 12 * ncolors:], "<u4" if order == 0 else ">u4")
+pix = pix[: hgt * stride // 4].reshape(hgt, stride // 4)[:, :w]
+ch = [(pix & m) >> (int(m) & -int(m)).bit_length() - 1 for m in masks]
+spread = np.max(ch, axis=0).astype(int) - np.min(ch, axis=0)
+print(int((spread >= 50).sum()))
+PY
+}
+
 # coloured pixels of mujoco-simulate's window on MODEL, paused at the model's reference pose;
 # "none" when no window came up in three tries (GLFW sometimes fails to open on a busy server)
 coloured_pixels() {
@@ -67,24 +89,24 @@ coloured_pixels() {
     echo none
     return
   fi
-  sleep 1
+  # wait until the viewer draws (its menus alone colour many pixels), then pause, reset and hide
+  # the menus; under load the window can take seconds to draw and to act on the keys, so poll:
+  # the count falls to the scene's once the menus are gone
+  local shown=0 now=0
+  for _ in $(seq 60); do
+    shown=$(grab "$win" "$2")
+    [ "$shown" -ge 20000 ] && break
+    sleep 0.5
+  done
   xdotool key --window "$win" space BackSpace Tab shift+Tab
-  sleep 3
-  xwd -id "$win" -silent >"$2.xwd"
-  /usr/bin/python3 - "$2.xwd" <<'PY'
-import sys
-import numpy as np
-d = open(sys.argv[1], "rb").read()
-h = np.frombuffer(d[:100], ">u4")  # XWD header: 25 big-endian words
-size, w, hgt, order, bpp, stride, ncolors = h[0], h[4], h[5], h[7], h[11], h[12], h[19]
-masks = h[14:17]
-assert bpp == 32, "expected 32 bits per pixel"
-pix = np.frombuffer(d[size + 12 * ncolors:], "<u4" if order == 0 else ">u4")
-pix = pix[: hgt * stride // 4].reshape(hgt, stride // 4)[:, :w]
-ch = [(pix & m) >> (int(m) & -int(m)).bit_length() - 1 for m in masks]
-spread = np.max(ch, axis=0).astype(int) - np.min(ch, axis=0)
-print(int((spread >= 50).sum()))
-PY
+  for _ in $(seq 60); do
+    sleep 0.5
+    now=$(grab "$win" "$2")
+    [ "$now" -lt $((shown / 4)) ] && break
+  done
+  echo "$1: $shown coloured pixels before the keys, $now after" >&2
+  sleep 1
+  grab "$win" "$2"
   kill "$sim_pid" 2>/dev/null
   wait "$sim_pid" 2>/dev/null
   sim_pid=""

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Issue 20's diagnostic figures of a main job's results (docs/BENCHMARKS.md, "Physiology").
 
-usage: scripts/physiology_figures.py [RESULTS]
+usage: scripts/physiology_figures.py [RESULTS] [--gaitsim GAITSIM]
 
 RESULTS (default results) is the folder `gaitsim run` writes. Prints:
   - for RESULTS/track: the mean and RMS difference, model minus measured, of the frontal-plane
@@ -11,6 +11,12 @@ RESULTS (default results) is the folder `gaitsim run` writes. Prints:
   - for each RESULTS/sweep/predict_*: the stride-mean metabolic power by muscle group
     (metabolics.sto, trapezoid over the nodes; W/kg, and J/(kg m) at the prediction's speed),
     and the mean lumbar_extension (deg).
+With --gaitsim (the built binary), also, for the tracking solution and each prediction: what the
+trunk muscles (ercspn, intobl, extobl) carry about each lumbar coordinate at 20 instants of the
+stride (`GAITSIM inspect MODEL --pose DIR/states.sto --time t`, MODEL from summary.json): their
+summed power (W) and the mean over the instants of the net moment |sum F r| and of the summed
+muscle moments sum |F r| (N m); the ratio of the two is the co-contraction the lumbar moments
+cost.
 Muscle groups by name: trunk (ercspn, intobl, extobl), vasti, soleus, gastrocnemii, rectus
 femoris, hamstrings, gluteals, iliopsoas, adductors, tibialis anterior, other. Exit 1 with one
 line naming the file when an input is missing.
@@ -18,6 +24,7 @@ line naming the file when an input is missing.
 import glob
 import os
 import re
+import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -93,15 +100,68 @@ def prediction(folder):
               f"{100 * power[name] / total:5.1f} %")
 
 
+TRUNK = re.compile(r"^(ercspn|intobl|extobl)")
+LUMBAR = ("lumbar_extension", "lumbar_bending", "lumbar_rotation")
+TRUNK_INSTANTS = 20
+
+
+def trunk_moments(gaitsim, folder):
+    """The trunk muscles' power (W) and, per lumbar coordinate, the mean net and summed moments
+    (N m) over TRUNK_INSTANTS instants of the stride, from `gaitsim inspect`'s rows (muscle,
+    tendon, lMT, lM, lM/lopt, F, Edot, then coordinate=arm pairs)."""
+    s = read_json(os.path.join(folder, "summary.json"))
+    T, model = s.get("stride_time_s"), s.get("model")
+    if not T or not model:
+        raise PrepError(os.path.join(folder, "summary.json"), "no stride_time_s or model")
+    power, net, summed = 0.0, {c: 0.0 for c in LUMBAR}, {c: 0.0 for c in LUMBAR}
+    for k in range(TRUNK_INSTANTS):
+        cmd = [gaitsim, "inspect", model, "--pose", os.path.join(folder, "states.sto"),
+               "--time", f"{T * k / TRUNK_INSTANTS:.6f}"]
+        res = subprocess.run(cmd, capture_output=True, text=True)
+        if res.returncode != 0:
+            raise PrepError(folder, f"gaitsim inspect failed: {res.stderr.strip()}")
+        m = {c: 0.0 for c in LUMBAR}
+        for line in res.stdout.splitlines():
+            f = line.split()
+            if len(f) < 7 or not TRUNK.match(f[0]):
+                continue
+            force = float(f[5])
+            power += float(f[6]) / TRUNK_INSTANTS
+            for pair in f[7:]:
+                c, arm = pair.split("=")
+                if c in m:
+                    m[c] += force * float(arm)
+                    summed[c] += abs(force * float(arm)) / TRUNK_INSTANTS
+        for c in LUMBAR:
+            net[c] += abs(m[c]) / TRUNK_INSTANTS
+    print(f"{folder}: trunk muscles {power:.1f} W; about each lumbar coordinate the mean net and "
+          "summed muscle moments (N m)")
+    for c in LUMBAR:
+        print(f"  {c:18s} {net[c]:7.1f} {summed[c]:7.1f}")
+
+
 def main(argv):
-    results = argv[1] if len(argv) > 1 else "results"
-    if len(argv) > 2 or results in ("-h", "--help"):
+    args = argv[1:]
+    gaitsim = None
+    if "--gaitsim" in args:
+        i = args.index("--gaitsim")
+        if i + 1 >= len(args):
+            print("physiology_figures: --gaitsim needs the binary's path", file=sys.stderr)
+            return 2
+        gaitsim = args[i + 1]
+        del args[i:i + 2]
+    results = args[0] if args else "results"
+    if len(args) > 1 or results in ("-h", "--help"):
         print(__doc__.split("\n\n")[1], file=sys.stderr)
         return 2
     try:
         tracking(os.path.join(results, "track"))
         for folder in sorted(glob.glob(os.path.join(results, "sweep", "predict_*"))):
             prediction(folder)
+        if gaitsim:
+            for folder in [os.path.join(results, "track")] + \
+                    sorted(glob.glob(os.path.join(results, "sweep", "predict_*"))):
+                trunk_moments(gaitsim, folder)
     except PrepError as e:
         print(f"physiology_figures: {e}", file=sys.stderr)
         return 1

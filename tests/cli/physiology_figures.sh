@@ -3,8 +3,11 @@
 # hip_adduction is the trial's minus 5 deg at every node (mean -5.000, RMS 5.000; the model's
 # mean +1.00 against the measured +6.00 over the nodes), and a prediction at 2.0 m/s of a 1000 N
 # (101.94 kg) body whose erector spinae spend 300 W and vasti 100 W throughout (trunk 2.943
-# W/kg, 1.472 J/(kg m), 75 % of 3.924 W/kg; vasti 0.981 W/kg, 0.490 J/(kg m)); a missing
-# states.sto exits 1 with one line naming it.
+# W/kg, 1.472 J/(kg m), 75 % of 3.924 W/kg; vasti 0.981 W/kg, 0.490 J/(kg m)); with --gaitsim
+# a stand-in binary whose `inspect` rows give ercspn_r 100 N (arms 0.04 extension, 0.03
+# bending; 10 W) and extobl_r 50 N (-0.06, 0.02; 5 W) and vasint 500 N (knee only) at every
+# instant: trunk 15.0 W, extension net |4 - 3| = 1.0 and summed 7.0 N m, bending 4.0 and 4.0,
+# rotation 0; a missing states.sto exits 1 with one line naming it.
 # usage: physiology_figures.sh GAITSIM SOURCE_DIR
 set -u
 src=$2
@@ -20,11 +23,13 @@ os.makedirs("trial"); os.makedirs("results/track"); os.makedirs("results/sweep/p
 sto("trial/coordinates.mot", ["time", "hip_adduction"], [[0.1 * k, 1.0 + k] for k in range(11)])
 sto("results/track/states.sto", ["time", "hip_adduction"],
     [[0.2 * k, -4.0 + 2 * k] for k in range(6)])
-json.dump({"trial": "trial"}, open("results/track/summary.json", "w"))
+json.dump({"trial": "trial", "model": "m.xml", "stride_time_s": 1.0},
+          open("results/track/summary.json", "w"))
 sto("results/sweep/predict_2/metabolics.sto", ["time", "ercspn_r", "vasint", "total"],
     [[0.25 * k, 300.0, 100.0, 400.0] for k in range(5)])
 sto("results/sweep/predict_2/states.sto", ["time", "lumbar_extension"], [[0, -15.0], [1, -17.0]])
-json.dump({"body_weight_n": 1000.0, "speed_target_mps": 2.0},
+json.dump({"body_weight_n": 1000.0, "speed_target_mps": 2.0, "model": "m.xml",
+           "stride_time_s": 1.0},
           open("results/sweep/predict_2/summary.json", "w"))
 PY
 out=$(/usr/bin/python3 "$src/scripts/physiology_figures.py" results)
@@ -35,6 +40,24 @@ line="results/sweep/predict_2: 2.0 m/s, muscles 3.92 W/kg (1.96 J/(kg m)), lumba
 check "muscles 3.92 W/kg, lumbar -16.0" grep -qF "$line mean -16.0 deg" <<<"$out"
 check "trunk 75 %" grep -qE "^  trunk +2\.943 W/kg +1\.472 J/\(kg m\) +75\.0 %$" <<<"$out"
 check "vasti 25 %" grep -qE "^  vasti +0\.981 W/kg +0\.490 J/\(kg m\) +25\.0 %$" <<<"$out"
+
+cat >fake_gaitsim <<'SH'
+#!/usr/bin/env bash
+[ "$1" = inspect ] || exit 2
+echo "m.xml at t = $5 s"
+echo "muscle           tendon   lMT (m)   lM (m) lM/lopt     F (N)  Edot (W)  moment arms (m)"
+echo "ercspn_r         rigid     0.1465   0.1168   1.014     100.0     10.00  lumbar_extension=0.0400 lumbar_bending=0.0300"
+echo "extobl_r         elastic   0.2712   0.1369   1.198      50.0      5.00  lumbar_extension=-0.0600 lumbar_bending=0.0200"
+echo "vasint           elastic   0.3044   0.0663   0.667     500.0      2.90  knee_flexion=0.0447"
+SH
+chmod +x fake_gaitsim
+out=$(/usr/bin/python3 "$src/scripts/physiology_figures.py" results --gaitsim ./fake_gaitsim)
+status=$?
+check "--gaitsim: exit 0 (got $status)" test "$status" -eq 0
+check "--gaitsim: trunk 15.0 W" grep -qF "results/sweep/predict_2: trunk muscles 15.0 W;" <<<"$out"
+check "--gaitsim: extension 1.0 / 7.0" grep -qE "^  lumbar_extension +1\.0 +7\.0$" <<<"$out"
+check "--gaitsim: bending 4.0 / 4.0" grep -qE "^  lumbar_bending +4\.0 +4\.0$" <<<"$out"
+check "--gaitsim: rotation 0" grep -qE "^  lumbar_rotation +0\.0 +0\.0$" <<<"$out"
 
 rm results/track/states.sto
 err=$(/usr/bin/python3 "$src/scripts/physiology_figures.py" results 2>&1 >/dev/null)

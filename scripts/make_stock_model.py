@@ -134,6 +134,12 @@ def mj_fv(V, fvmax):
                     np.where(V <= y, fvmax - (y - V) ** 2 / y, fvmax)))
 
 
+def mj_isometric_tension(L, acts, lmin, lmax, fpmax):
+    """MuJoCo 2.2.2's isometric tension / force at normalised lengths L and activations acts:
+    act FL(L) + FP(L) (mju_muscleGain + mju_muscleBias at zero velocity)."""
+    return acts * mj_fl(L, lmin, lmax) + mj_fp(L, lmax, fpmax)
+
+
 def mj_act_dot(u, a, tau):
     t = np.where(u > a, tau[0] * (0.5 + 1.5 * a), tau[1] / (0.5 + 1.5 * a))
     return (u - a) / t
@@ -265,7 +271,7 @@ def fit_muscle(lmt, force, fmax, lopt, lnorm, lmt_min):
 
     def resid(p, reg):
         L = p[1] + p[2] * x
-        model = p[0] * (acts * mj_fl(L, p[3], p[4]) + mj_fp(L, p[4], p[5]))
+        model = p[0] * mj_isometric_tension(L, acts, p[3], p[4], p[5])
         r = (model - target).ravel()
         below = max(0.0, p[3] + 0.02 - (p[1] + p[2] * lmt_min / lopt))
         return np.concatenate([r, reg * (p - x0), [1e3 * below]])
@@ -289,8 +295,8 @@ def muscle_fit_rms(el, lmt, force, fmax, lopt):
     L = rng[0] + (lmt - lr[0]) * (rng[1] - rng[0]) / (lr[1] - lr[0])
     lmin, lmax, fpmax = float(el.get("lmin")), float(el.get("lmax")), float(el.get("fpmax"))
     acts = np.array(ACTIVATIONS)[:, None]
-    model = float(el.get("force")) / fmax * (acts * mj_fl(L[None, :].repeat(len(ACTIVATIONS), 0),
-                                                          lmin, lmax) + mj_fp(L, lmax, fpmax))
+    model = float(el.get("force")) / fmax * mj_isometric_tension(L[None, :], acts, lmin, lmax,
+                                                                  fpmax)
     return math.sqrt(np.mean((model - force / fmax) ** 2))
 
 

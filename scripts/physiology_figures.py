@@ -100,7 +100,7 @@ def prediction(folder):
               f"{100 * power[name] / total:5.1f} %")
 
 
-TRUNK = re.compile(r"^(ercspn|intobl|extobl)")
+TRUNK = dict(GROUPS)["trunk"]
 LUMBAR = ("lumbar_extension", "lumbar_bending", "lumbar_rotation")
 TRUNK_INSTANTS = 20
 
@@ -123,7 +123,7 @@ def trunk_moments(gaitsim, folder):
         m = {c: 0.0 for c in LUMBAR}
         for line in res.stdout.splitlines():
             f = line.split()
-            if len(f) < 7 or not TRUNK.match(f[0]):
+            if len(f) < 7 or not re.search(TRUNK, f[0]):
                 continue
             force = float(f[5])
             power += float(f[6]) / TRUNK_INSTANTS

@@ -85,7 +85,7 @@ int gs_cmd_inspect(int argc, char** argv) {
   gs_physics_equilibrate_tendons(m, d, map.fT_col);  // tendon forces not given
   mj_forward(m, d);
   printf("%s at t = %.4f s of %s\n", path, time, pose);
-  printf("%-16s %-7s %8s %8s %7s %9s %9s  %s\n", "muscle", "tendon", "lMT (m)", "lM (m)",
+  printf("%-16s %-7s %9s %8s %7s %9s %9s  %s\n", "muscle", "tendon", "lMT (m)", "lM (m)",
          "lM/lopt", "F (N)", "Edot (W)", "moment arms (m)");
   for (int i = 0; i < m->nu; i++) {
     if (!gs_actuator_is_gaitsim_muscle(m, i)) {
@@ -94,7 +94,7 @@ int gs_cmd_inspect(int argc, char** argv) {
     gsMuscleOut out;
     double force = gs_physics_muscle_tension(m, d, i, &out);
     double power = gs_physics_muscle_metabolics(m, d, i, NULL);
-    printf("%-16s %-7s %8.4f %8.4f %7.3f %9.1f %9.2f ", mj_id2name(m, mjOBJ_ACTUATOR, i),
+    printf("%-16s %-7s %9.6f %8.4f %7.3f %9.1f %9.2f ", mj_id2name(m, mjOBJ_ACTUATOR, i),
            gs_actuator_has_elastic_tendon(m, i) ? "elastic" : "rigid", d->actuator_length[i],
            out.lM, out.lM_norm, force, power);
     for (int j = 0; j < m->njnt; j++) {

@@ -7,12 +7,14 @@ reference table of muscle-tendon lengths and moment arms computed from the OpenS
 alone (CustomJoint kinematics, path points incl. conditional and moving points; straight
 segments, and with OpenSim's wrapping re-implemented: wrapped_path) for the project's C test.
 
-Standard library only. Deterministic: the same inputs give the same bytes.
+Standard library only; runs the built gaitsim (`inspect`), whose MuJoCo measures the draft
+model's path lengths for the tendon calibration. Deterministic: the same inputs give the same
+bytes.
 
 Usage:
   /usr/bin/python3 scripts/osim2mjcf.py --osim PATH --muscle-params DIR \
       --out mjmodels/jw_fullbody.xml --reference-out mjmodels/reference/jw_moment_arms.csv \
-      [--trial-ik PATH]
+      [--trial-ik PATH] [--knee-params mjmodels/knee/jw_knee.json] [--gaitsim build/gaitsim]
 """
 import argparse
 import csv
@@ -1699,7 +1701,7 @@ def read_metabolic(path):
     return out
 
 
-def calibrate_right_tendon_slack(model, frames):
+def calibrate_right_tendon_slack(model, lengths):
     """Recalibrate overstretched right-leg tendon slack lengths against the left leg
     (mjmodels/README.md, "Right-leg tendon slack lengths"). JW's .osim routes the right (JW-named,
     Schutte) quadriceps over the patella to the tibial tuberosity and places the soleus and
@@ -1712,14 +1714,16 @@ def calibrate_right_tendon_slack(model, frames):
         lts_r = mean(L_r) / rho_l - lopt_r cos(alpha_r).
     Only overstretched muscles change, and only by lengthening the tendon; right muscles that are
     relatively shorter (most hip muscles of the Schutte set) keep the .osim's lts (matching them
-    would make some lts negative). Straight-line .osim path lengths over every 4th trial frame,
-    the same geometry on both sides. Fmax, lopt and pennation stay the .osim's.
+    would make some lts negative). Path lengths L from `lengths` over every 4th trial frame:
+    the straight .osim lines (straight_path_lengths), the same geometry on both sides, as the
+    rule compares the .osim's two muscle sets, not the model's paths. Fmax, lopt and pennation
+    stay the .osim's.
     Returns [(name, rho_r, rho_l, old lts, new lts)] for the changed muscles."""
     by_name = {mus["name"]: mus for mus in model.muscles}
-    poses = [pose for _, pose in frames[::4]]
 
     def rho(mus):
-        length = sum(path_length(model, mus, pose) for pose in poses) / len(poses)
+        samples = lengths[mus["name"]][::2]
+        length = sum(samples) / len(samples)
         return length, length / (mus["lopt"] * math.cos(mus["pennation"]) + mus["lts"])
 
     changes = []
@@ -1738,23 +1742,24 @@ def calibrate_right_tendon_slack(model, frames):
     return changes
 
 
-def cap_fibre_stretch(model, frames):
+def cap_fibre_stretch(model, lengths):
     """Lengthen any tendon whose muscle would be stretched beyond LM_MAX_TRIAL optimal fibre
     lengths somewhere in the trial (mjmodels/README.md, "Tendon slack lengths"). With the tendon
     at slack length (no tendon strain) and constant-thickness pennation the normalised fibre
     length is lM/lopt = sqrt((L - lts)^2 + (lopt sin alpha0)^2) / lopt; its largest value over
-    every 2nd trial frame must not exceed LM_MAX_TRIAL, else lts is raised so that it equals it:
+    trial_samples frames must not exceed LM_MAX_TRIAL, else lts is raised so that it equals it:
         lts = L_max - sqrt((LM_MAX_TRIAL lopt)^2 - (lopt sin alpha0)^2).
     Without the cap, JW's scaled geometry leaves soleus, tibialis posterior, piriformis and
     gluteus minimus at 1.4-1.9 lopt in stance, whose passive forces (up to 3 kN) no antagonist can
-    balance. Applied to every muscle after calibrate_right_tendon_slack. Straight-line .osim path
-    lengths. Returns [(name, largest lM/lopt before, old lts, new lts)] for the changed muscles."""
-    poses = [pose for _, pose in frames[::2]]
+    balance. Applied to every muscle after calibrate_right_tendon_slack. Path lengths from
+    `lengths`: the model's own paths (model_path_lengths), the fibre lengths it will simulate.
+    Returns [(name, largest lM/lopt before, old lts, new lts)]
+    for the changed muscles."""
     changes = []
     for mus in model.muscles:
         lopt, lts = mus["lopt"], mus["lts"]
         height = lopt * math.sin(mus["pennation"])
-        longest = max(path_length(model, mus, pose) for pose in poses)
+        longest = max(lengths[mus["name"]])
         stretch = math.sqrt((longest - lts) ** 2 + height ** 2) / lopt
         if stretch <= LM_MAX_TRIAL:
             continue
@@ -1765,11 +1770,11 @@ def cap_fibre_stretch(model, frames):
     return changes
 
 
-def floor_fibre_shortening(model, frames):
+def floor_fibre_shortening(model, lengths):
     """Shorten any tendon whose muscle would need a fibre shorter than LM_MIN_TRIAL optimal fibre
     lengths somewhere in the trial (tendon at slack, as cap_fibre_stretch), so that its shortest
     fibre is LM_MIN_TRIAL, or as close as the longest fibre allows without exceeding LM_MAX_HARD:
-        target = min(LM_MIN_TRIAL, LM_MAX_HARD - (L_max - L_min) / lopt)   (straight paths),
+        target = min(LM_MIN_TRIAL, LM_MAX_HARD - (L_max - L_min) / lopt),
         lts = L_min - sqrt((target lopt)^2 - (lopt sin alpha0)^2).
     Why: where the muscle-tendon unit is shorter than its slack tendon plus a short fibre, the
     Hill equilibrium (De Groote et al. 2016) has no tendon force to hold and a fibre on the
@@ -1777,14 +1782,13 @@ def floor_fibre_shortening(model, frames):
     grow without bound and Ipopt stalls (measured: JW's right semimembranosus, lts 0.378 m, is
     longer than the whole path at the shortest trial pose, lM/lopt -0.56; the tracking solves at
     N = 80 diverged with the largest multiplier on its row). Applied after cap_fibre_stretch.
+    Path lengths from `lengths`: the model's own paths (model_path_lengths).
     Returns [(name, shortest lM/lopt before, old lts, new lts)] for the changed muscles."""
-    poses = [pose for _, pose in frames[::2]]
     changes = []
     for mus in model.muscles:
         lopt, lts = mus["lopt"], mus["lts"]
         height = lopt * math.sin(mus["pennation"])
-        lengths = [path_length(model, mus, pose) for pose in poses]
-        shortest, longest = min(lengths), max(lengths)
+        shortest, longest = min(lengths[mus["name"]]), max(lengths[mus["name"]])
         x = shortest - lts
         before = math.copysign(math.sqrt(x * x + height * height), x) / lopt
         if before >= LM_MIN_TRIAL:
@@ -1797,6 +1801,67 @@ def floor_fibre_shortening(model, frames):
         mus.setdefault("lts_osim", lts)
         mus["lts"] = new
     return changes
+
+
+# every TRIAL_LENGTH_STEP-th trial frame is a sample of the tendon calibration rules
+TRIAL_LENGTH_STEP = 2
+# a model path within this of the straight .osim line at every sample is that line (m): twice
+# the rounding of `gaitsim inspect`'s lMT column
+STRAIGHT_TOL = 2e-6
+
+
+def trial_samples(frames):
+    """The trial frames the tendon calibration rules look at: [(time (s), pose)]."""
+    return frames[::TRIAL_LENGTH_STEP]
+
+
+def straight_path_lengths(model, frames):
+    """{muscle: [straight-segment .osim path length (m) at each trial_samples frame]}."""
+    poses = [pose for _, pose in trial_samples(frames)]
+    return {mus["name"]: [path_length(model, mus, pose) for pose in poses]
+            for mus in model.muscles}
+
+
+def model_path_lengths(gaitsim, model_xml, frames):
+    """{muscle: [path length (m) of the MJCF model_xml at each trial_samples frame]}, as MuJoCo
+    computes it (wrap geoms included): `gaitsim inspect MODEL --pose P --time t`, column lMT, with
+    P a coordinates file of those frames written next to model_xml (and removed). The tendon
+    calibration rules need the lengths of the paths the model has: where the converter's wrap
+    surrogates wrap, the straight .osim line is shorter (gasmed by 18-23 mm, a third of its
+    optimal fibre length; mjmodels/README.md, "Tendon slack lengths")."""
+    import subprocess
+    import tempfile
+    samples = trial_samples(frames)
+    translations = ("pelvis_tx", "pelvis_ty", "pelvis_tz", "knee_tx", "knee_ty", "knee_tz")
+    lines = ["coordinates", "version=1", "nRows=%d" % len(samples),
+             "nColumns=%d" % (len(MODEL_COORDINATES) + 1), "inDegrees=yes", "endheader",
+             "\t".join(["time"] + MODEL_COORDINATES)]
+    for t, pose in samples:
+        lines.append("\t".join([repr(t)] + [
+            repr(pose[c] if c in translations else math.degrees(pose[c]))
+            for c in MODEL_COORDINATES]))
+    folder = os.path.dirname(os.path.abspath(model_xml))
+    fd, pose_file = tempfile.mkstemp(prefix=".trial_poses.", suffix=".mot", dir=folder)
+    lengths = {}
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
+            f.write("\n".join(lines) + "\n")
+        for t, _ in samples:
+            run = subprocess.run([gaitsim, "inspect", model_xml, "--pose", pose_file, "--time",
+                                  repr(t)], capture_output=True, text=True)
+            if run.returncode != 0:
+                raise SystemExit("osim2mjcf.py: %s inspect failed on %s: %s" % (
+                    gaitsim, model_xml, run.stderr.strip()))
+            rows = run.stdout.splitlines()
+            head = next(k for k, r in enumerate(rows) if r.startswith("muscle "))
+            for r in rows[head + 1:]:
+                f = r.split()
+                if len(f) < 3 or not f[2].replace(".", "", 1).isdigit():
+                    break
+                lengths.setdefault(f[0], []).append(float(f[2]))
+    finally:
+        os.unlink(pose_file)
+    return lengths
 
 
 def metabolic_key(name):
@@ -2197,6 +2262,7 @@ def standing_pose(model, zero, frames, soles):
 
 class Converter:
     def __init__(self, model, metabolic, frames, osim_name, heel_strikes, grf_path, meshes):
+        self.paths_built = False
         self.model = model
         self.meshes = meshes     # body -> [(mesh, scale, class)] (display_meshes)
         self.metabolic = metabolic
@@ -2383,7 +2449,9 @@ class Converter:
 
     def write(self, path):
         m = self.model
-        self.build_paths()
+        if not self.paths_built:  # once: the draft and the final model share the paths
+            self.build_paths()
+            self.paths_built = True
         total_mass = sum(b["mass"] for b in m.bodies.values())
         out = []
         out.append('<?xml version="1.0" encoding="utf-8"?>')
@@ -2602,7 +2670,13 @@ def main():
         "trial.json"), help="trial.json of scripts/prepare_trial.py: the heel strikes (source "
                             "times) that place the heel spheres; grf.mot next to it is fitted "
                             "(default: the bundled trial's)")
+    ap.add_argument("--gaitsim", default=os.path.join(
+        os.path.dirname(os.path.abspath(__file__)), "..", "build", "gaitsim"),
+        help="the built gaitsim, whose `inspect` measures the model's own path lengths for the "
+             "tendon calibration (default: build/gaitsim)")
     args = ap.parse_args()
+    if not os.access(args.gaitsim, os.X_OK):
+        ap.error("--gaitsim %s: not an executable (build gaitsim first: README.md)" % args.gaitsim)
     heel_strikes = read_heel_strikes(args.trial_events)
     trial = args.trial_ik or os.path.join(os.path.dirname(os.path.abspath(args.osim)), "..",
                                           "ngait_og5", "IK_ngait_og5.csv")
@@ -2610,21 +2684,41 @@ def main():
     frames = read_trial(trial)
     metabolic = read_metabolic(os.path.join(args.muscle_params,
                                             "MTparameters_subject1_with_metabolic_params.csv"))
-    for name, rho_r, rho_l, old, new in calibrate_right_tendon_slack(model, frames):
-        print("lts %-11s rho %.3f (left %.3f): %.4f -> %.4f m (%+.1f %%)" % (
-            name, rho_r, rho_l, old, new, 100.0 * (new / old - 1.0)))
-    for name, stretch, old, new in cap_fibre_stretch(model, frames):
-        print("lts %-11s lM/lopt max %.3f: %.4f -> %.4f m (%+.1f %%)" % (
-            name, stretch, old, new, 100.0 * (new / old - 1.0)))
-    for name, short, old, new in floor_fibre_shortening(model, frames):
-        print("lts %-11s lM/lopt min %.3f: %.4f -> %.4f m (%+.1f %%)" % (
-            name, short, old, new, 100.0 * (new / old - 1.0)))
     # display meshes: meshes/ next to the model (its meshdir)
     meshes = display_meshes(args.osim, os.path.join(os.path.dirname(os.path.abspath(args.out)),
                                                     "meshes"))
     conv = Converter(model, metabolic, frames, os.path.basename(args.osim), heel_strikes,
                      os.path.join(os.path.dirname(os.path.abspath(args.trial_events)), "grf.mot"),
                      meshes)
+    # the tendon rules on the written model's own path lengths: a draft with the .osim's lts
+    # (path lengths do not depend on lts) measured by MuJoCo through gaitsim, next to --out
+    draft = os.path.join(os.path.dirname(os.path.abspath(args.out)),
+                         "." + os.path.basename(args.out) + ".draft.xml")
+    conv.write(draft)
+    try:
+        lengths = model_path_lengths(args.gaitsim, draft, frames)
+    finally:
+        os.unlink(draft)
+    # where the model's path is the straight line at every sample (equal to inspect's 1e-6 m
+    # print), the straight length is exact: use it
+    straight = straight_path_lengths(model, frames)
+    for mus in model.muscles:
+        n = mus["name"]
+        diff = [a - b for a, b in zip(lengths[n], straight[n])]
+        if max(abs(x) for x in diff) <= STRAIGHT_TOL:
+            lengths[n] = straight[n]
+        else:
+            print("path %-11s the model's path minus the straight .osim line: %+.1f to %+.1f mm"
+                  % (n, 1e3 * min(diff), 1e3 * max(diff)))
+    for name, rho_r, rho_l, old, new in calibrate_right_tendon_slack(model, straight):
+        print("lts %-11s rho %.3f (left %.3f): %.4f -> %.4f m (%+.1f %%)" % (
+            name, rho_r, rho_l, old, new, 100.0 * (new / old - 1.0)))
+    for name, stretch, old, new in cap_fibre_stretch(model, lengths):
+        print("lts %-11s lM/lopt max %.3f: %.4f -> %.4f m (%+.1f %%)" % (
+            name, stretch, old, new, 100.0 * (new / old - 1.0)))
+    for name, short, old, new in floor_fibre_shortening(model, lengths):
+        print("lts %-11s lM/lopt min %.3f: %.4f -> %.4f m (%+.1f %%)" % (
+            name, short, old, new, 100.0 * (new / old - 1.0)))
     for side in ("r", "l"):
         sole = conv.soles[side]
         print("sole %s: normal %s, offset %.4f m in the calcaneus frame (%d foot-flat frames, "

@@ -44,8 +44,12 @@
 #define MUSCLE_RMS_TOL 0.10   // RMS / Fmax (-)
 #define PRESS_TOL 0.15        // relative vertical force (-)
 #define FLOOR_TOL 0.02        // deepest collision geom point below the floor (m)
+// the largest change over the collapse: a transient at the landing (t ~ 0.5 s), which depends on
+// how the chaotic collapse lands (knee_ty 0.7 mm with one muscle fit, 5.5 mm with another; both
+// back under 0.1 mm by 2 s); a knee that comes apart (the implant knee without its springs)
+// moves 67 mm
 #define KNEE_AP_TOL 0.010     // knee_tx (anterior-posterior) from standing (m)
-#define KNEE_TRANS_TOL 0.005  // knee_ty, knee_tz from standing (m)
+#define KNEE_TRANS_TOL 0.010  // knee_ty, knee_tz from standing (m)
 #define KNEE_ADD_TOL 0.0873   // knee_adduction from standing (rad, 5 deg)
 #define KNEE_ROT_TOL 0.1745   // knee_rotation from standing (rad, 10 deg)
 #define DROP_TIME 2.0         // checked span of the drop (s)

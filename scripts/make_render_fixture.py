@@ -25,16 +25,7 @@ import sys
 import xml.etree.ElementTree as ET
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gs_scriptlib import PrepError, read_storage, write_atomic  # noqa: E402
-
-
-def storage_text(name, labels, rows, in_degrees, notes):
-    out = [name, "version=1", f"nRows={len(rows)}", f"nColumns={len(labels)}",
-           f"inDegrees={'yes' if in_degrees else 'no'}", "DataType=double"]
-    out += notes
-    out += ["endheader", "\t".join(labels)]
-    out += ["\t".join(f"{v:.8g}" for v in r) for r in rows]
-    return "\n".join(out) + "\n"
+from gs_scriptlib import PrepError, read_storage, storage_text, write_atomic  # noqa: E402
 
 
 def main():

@@ -47,7 +47,7 @@ import xml.etree.ElementTree as ET
 import numpy as np
 from scipy.optimize import least_squares
 
-from gs_scriptlib import PrepError, read_storage, write_atomic
+from gs_scriptlib import PrepError, inspect_muscles, read_storage, storage_text, write_atomic
 
 ACTIVATIONS = (0.05, 0.5, 1.0)
 
@@ -177,19 +177,9 @@ def mj_static_force(d, K, A, solimp):
 
 # --- inputs -----------------------------------------------------------------------------------
 def run_inspect(gaitsim, model, pose_file, time, activation):
-    """{muscle: (lMT (m), lM/lopt (-), F (N))} from `gaitsim inspect`."""
-    cmd = [gaitsim, "inspect", model, "--pose", pose_file, "--time", repr(time),
-           "--activation", repr(activation)]
-    res = subprocess.run(cmd, capture_output=True, text=True)
-    if res.returncode != 0:
-        raise PrepError(gaitsim, f"inspect failed: {res.stderr.strip()}")
-    out, rows = {}, res.stdout.splitlines()
-    for line in rows[2:]:
-        f = line.split()
-        if not f or f[0] == "contact":
-            break
-        out[f[0]] = (float(f[2]), float(f[4]), float(f[5]))
-    return out
+    """{muscle: (lMT (m), lM/lopt (-), F (N))} from `gaitsim inspect` (gs_scriptlib)."""
+    return {name: (r["lMT"], r["lM_norm"], r["F"])
+            for name, r in inspect_muscles(gaitsim, model, pose_file, time, activation).items()}
 
 
 def write_poses_mot(csv_path, mot_path):
@@ -197,13 +187,10 @@ def write_poses_mot(csv_path, mot_path):
     with open(csv_path, encoding="utf-8") as f:
         lines = [ln.strip() for ln in f if ln.strip() and not ln.startswith("#")]
     labels = lines[0].split(",")[1:]
-    rows = [ln.split(",") for ln in lines[1:]]
-    text = ["jw_poses", "version=1", f"nRows={len(rows)}", f"nColumns={len(labels) + 1}",
-            "inDegrees=no", "endheader", "\t".join(["time"] + labels)]
-    text += ["\t".join([r[0]] + r[1:]) for r in rows]
+    rows = [[float(v) for v in ln.split(",")] for ln in lines[1:]]
     with open(mot_path, "w", encoding="utf-8") as f:
-        f.write("\n".join(text) + "\n")
-    return [float(r[0]) for r in rows]
+        f.write(storage_text("jw_poses", ["time"] + labels, rows, False, cell=repr))
+    return [r[0] for r in rows]
 
 
 def invweight0(source):

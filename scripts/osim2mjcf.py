@@ -23,7 +23,7 @@ import math
 import os
 import xml.etree.ElementTree as ET
 
-from gs_scriptlib import write_atomic
+from gs_scriptlib import PrepError, inspect_muscles, storage_text, write_atomic
 
 CONVERTER = "scripts/osim2mjcf.py"
 
@@ -1829,36 +1829,25 @@ def model_path_lengths(gaitsim, model_xml, frames):
     calibration rules need the lengths of the paths the model has: where the converter's wrap
     surrogates wrap, the straight .osim line is shorter (gasmed by 18-23 mm, a third of its
     optimal fibre length; mjmodels/README.md, "Tendon slack lengths")."""
-    import subprocess
     import tempfile
     samples = trial_samples(frames)
     translations = ("pelvis_tx", "pelvis_ty", "pelvis_tz", "knee_tx", "knee_ty", "knee_tz")
-    lines = ["coordinates", "version=1", "nRows=%d" % len(samples),
-             "nColumns=%d" % (len(MODEL_COORDINATES) + 1), "inDegrees=yes", "endheader",
-             "\t".join(["time"] + MODEL_COORDINATES)]
-    for t, pose in samples:
-        lines.append("\t".join([repr(t)] + [
-            repr(pose[c] if c in translations else math.degrees(pose[c]))
-            for c in MODEL_COORDINATES]))
+    rows = [[t] + [pose[c] if c in translations else math.degrees(pose[c])
+                   for c in MODEL_COORDINATES] for t, pose in samples]
     folder = os.path.dirname(os.path.abspath(model_xml))
     fd, pose_file = tempfile.mkstemp(prefix=".trial_poses.", suffix=".mot", dir=folder)
     lengths = {}
     try:
         with os.fdopen(fd, "w", encoding="utf-8", newline="\n") as f:
-            f.write("\n".join(lines) + "\n")
+            f.write(storage_text("coordinates", ["time"] + MODEL_COORDINATES, rows, True,
+                                 cell=repr))
         for t, _ in samples:
-            run = subprocess.run([gaitsim, "inspect", model_xml, "--pose", pose_file, "--time",
-                                  repr(t)], capture_output=True, text=True)
-            if run.returncode != 0:
-                raise SystemExit("osim2mjcf.py: %s inspect failed on %s: %s" % (
-                    gaitsim, model_xml, run.stderr.strip()))
-            rows = run.stdout.splitlines()
-            head = next(k for k, r in enumerate(rows) if r.startswith("muscle "))
-            for r in rows[head + 1:]:
-                f = r.split()
-                if len(f) < 3 or not f[2].replace(".", "", 1).isdigit():
-                    break
-                lengths.setdefault(f[0], []).append(float(f[2]))
+            try:
+                muscles = inspect_muscles(gaitsim, model_xml, pose_file, t)
+            except PrepError as e:
+                raise SystemExit("osim2mjcf.py: %s" % e)
+            for name, r in muscles.items():
+                lengths.setdefault(name, []).append(r["lMT"])
     finally:
         os.unlink(pose_file)
     return lengths
@@ -2262,7 +2251,6 @@ def standing_pose(model, zero, frames, soles):
 
 class Converter:
     def __init__(self, model, metabolic, frames, osim_name, heel_strikes, grf_path, meshes):
-        self.paths_built = False
         self.model = model
         self.meshes = meshes     # body -> [(mesh, scale, class)] (display_meshes)
         self.metabolic = metabolic
@@ -2292,6 +2280,7 @@ class Converter:
         self.wrap_geoms = {}     # body -> [wrap geom spec]
         self.tendons = []        # (muscle, [elements])
         self.notes = {"moving": [], "conditional": [], "dropped_wraps": []}
+        self.build_paths()  # paths do not depend on the tendon rules that run after
 
     # --- bodies ------------------------------------------------------------------------------
 
@@ -2449,9 +2438,6 @@ class Converter:
 
     def write(self, path):
         m = self.model
-        if not self.paths_built:  # once: the draft and the final model share the paths
-            self.build_paths()
-            self.paths_built = True
         total_mass = sum(b["mass"] for b in m.bodies.values())
         out = []
         out.append('<?xml version="1.0" encoding="utf-8"?>')

@@ -24,11 +24,10 @@ line naming the file when an input is missing.
 import glob
 import os
 import re
-import subprocess
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gs_scriptlib import PrepError, read_json, read_storage  # noqa: E402
+from gs_scriptlib import PrepError, inspect_muscles, read_json, read_storage  # noqa: E402
 
 COORDINATES = ["pelvis_tz", "pelvis_rx", "hip_adduction", "hip_adduction_l", "knee_adduction",
                "subtalar_angle", "subtalar_angle_l", "lumbar_extension", "lumbar_bending"]
@@ -107,31 +106,28 @@ TRUNK_INSTANTS = 20
 
 def trunk_moments(gaitsim, folder):
     """The trunk muscles' power (W) and, per lumbar coordinate, the mean net and summed moments
-    (N m) over TRUNK_INSTANTS instants of the stride, from `gaitsim inspect`'s rows (muscle,
-    tendon, lMT, lM, lM/lopt, F, Edot, then coordinate=arm pairs)."""
+    (N m) over TRUNK_INSTANTS instants of the stride, from `gaitsim inspect`'s rows
+    (inspect_muscles)."""
     s = read_json(os.path.join(folder, "summary.json"))
     T, model = s.get("stride_time_s"), s.get("model")
     if not T or not model:
         raise PrepError(os.path.join(folder, "summary.json"), "no stride_time_s or model")
     power, net, summed = 0.0, {c: 0.0 for c in LUMBAR}, {c: 0.0 for c in LUMBAR}
     for k in range(TRUNK_INSTANTS):
-        cmd = [gaitsim, "inspect", model, "--pose", os.path.join(folder, "states.sto"),
-               "--time", f"{T * k / TRUNK_INSTANTS:.6f}"]
-        res = subprocess.run(cmd, capture_output=True, text=True)
-        if res.returncode != 0:
-            raise PrepError(folder, f"gaitsim inspect failed: {res.stderr.strip()}")
+        try:
+            rows = inspect_muscles(gaitsim, model, os.path.join(folder, "states.sto"),
+                                   round(T * k / TRUNK_INSTANTS, 6))
+        except PrepError as e:
+            raise PrepError(folder, f"gaitsim {e.reason}")
         m = {c: 0.0 for c in LUMBAR}
-        for line in res.stdout.splitlines():
-            f = line.split()
-            if len(f) < 7 or not re.search(TRUNK, f[0]):
+        for name, r in rows.items():
+            if not re.search(TRUNK, name):
                 continue
-            force = float(f[5])
-            power += float(f[6]) / TRUNK_INSTANTS
-            for pair in f[7:]:
-                c, arm = pair.split("=")
+            power += r["Edot"] / TRUNK_INSTANTS
+            for c, arm in r["arms"].items():
                 if c in m:
-                    m[c] += force * float(arm)
-                    summed[c] += abs(force * float(arm)) / TRUNK_INSTANTS
+                    m[c] += r["F"] * arm
+                    summed[c] += abs(r["F"] * arm) / TRUNK_INSTANTS
         for c in LUMBAR:
             net[c] += abs(m[c]) / TRUNK_INSTANTS
     print(f"{folder}: trunk muscles {power:.1f} W; about each lumbar coordinate the mean net and "

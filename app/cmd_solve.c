@@ -923,6 +923,9 @@ static const char* kPredictUsage =
     "                      gs_metabolics.h times F; default " GO_STR(GO_PREDICT_METABOLIC_SMOOTHING)
     ": steps 0.1 wide, which lets the\n"
     "                      solves converge; summary.json gives the exact cost of transport too)\n"
+    "  --jacobian forward|central  finite differences of the path rows in the main solve:\n"
+    "                      forward (half the model evaluations per Jacobian) or central\n"
+    "                      (default " GO_PREDICT_JACOBIAN_NAME "; the polish uses central ones)\n"
     "  --no-polish         no feasibility polish of a solve that stopped short\n"
     "  --fallback-rise F   stop when the objective rises by more than the fraction F above the\n"
     "                      lowest one reached at a violation <= " GO_STR(GO_FALLBACK_VIOL)
@@ -945,7 +948,8 @@ int gs_cmd_predict(int argc, char** argv) {
       {"fallback-rise", required_argument, NULL, 'R'},
       {"min-vgrf", required_argument, NULL, 'W'},
       {"stride-time", required_argument, NULL, 'D'},
-      {"stride-time-start", required_argument, NULL, 'E'},    {NULL, 0, NULL, 0}};
+      {"stride-time-start", required_argument, NULL, 'E'},
+      {"jacobian", required_argument, NULL, 'J'},             {NULL, 0, NULL, 0}};
   gsTrackOptions o;
   defaults(&o);
   o.predict = 1;
@@ -955,6 +959,7 @@ int gs_cmd_predict(int argc, char** argv) {
                            // "Predictions: the metabolic Hessian and Newton")
   o.plan.max_iter = GO_MAX_ITER;
   go_solve_plan_settle_main(&o.plan, GO_PREDICT_SETTLE_VIOL, GO_PREDICT_SETTLE_REL);
+  o.plan.main_jacobian = GO_PREDICT_FORWARD_JACOBIAN ? GO_JAC_SPARSE_FORWARD : GO_JAC_SPARSE;
   o.nodes = GO_NODES_PREDICT;
   o.w_effort = GO_PREDICT_W_EFFORT;
   o.w_accel = GO_PREDICT_W_ACCEL;
@@ -965,7 +970,7 @@ int gs_cmd_predict(int argc, char** argv) {
   opterr = 0;
   int c, bad = 0, model_given = 0, nodes_given = 0;
   char err[256];
-  while (!bad && (c = getopt_long(argc, argv, ":g:s:o:m:n:t:i:T:w:PFS:R:W:D:E:p:h", options,
+  while (!bad && (c = getopt_long(argc, argv, ":g:s:o:m:n:t:i:T:w:PFS:R:W:D:E:J:p:h", options,
                                   NULL)) != -1) {
     switch (c) {
       case 'g': o.guess = optarg; break;
@@ -1000,6 +1005,14 @@ int gs_cmd_predict(int argc, char** argv) {
       case 'S':
         bad = gs_opt_real("--metabolic-smoothing", optarg, 0, 1e3, GS_OPT_LO_OPEN,
                           &o.metabolic_smoothing);
+        break;
+      case 'J':
+        if (!strcmp(optarg, "forward") || !strcmp(optarg, "central")) {
+          o.plan.main_jacobian = optarg[0] == 'f' ? GO_JAC_SPARSE_FORWARD : GO_JAC_SPARSE;
+        } else {
+          fprintf(stderr, "gaitsim: --jacobian: '%s' is neither forward nor central\n", optarg);
+          bad = 1;
+        }
         break;
       case 'p':
         if (go_ipopt_opts_add(&o.plan.ipopt, optarg, err, sizeof(err)) != 0) {

@@ -85,6 +85,10 @@ typedef enum {
   GO_JAC_SPARSE = 0,  // per-node central differences over column groups + analytic columns
   GO_JAC_DENSE = 1,   // baseline (the paper): central differences of the whole constraint vector
                       // over every variable, 2 n full evaluations
+  GO_JAC_SPARSE_FORWARD = 2,  // as GO_JAC_SPARSE with forward differences (step sqrt(eps)
+                              // max(1, |zs|)): one evaluation per group and one at the base
+                              // point instead of two per group; truncation error O(sqrt(eps))
+                              // relative instead of O(eps^(2/3))
 } go_jac_mode;
 
 // Plain description; arrays are copied by go_nlp_create, callbacks and contexts are kept.

@@ -99,6 +99,17 @@
 // factorisation per L-BFGS iteration, and the settled rule")
 #define GO_PREDICT_SETTLE_VIOL 1e-4
 #define GO_PREDICT_SETTLE_REL 1e-5
+// a prediction's main solve differentiates the path rows by central differences (0), not
+// forward ones (GO_JAC_SPARSE_FORWARD; 1, `predict --jacobian forward`): forward differences
+// make an 80-node iteration a third cheaper, but the 2.0 m/s prediction then went into a basin
+// 13 % higher in J and had not settled after 550 iterations (docs/BENCHMARKS.md, "Tried, not
+// kept: forward differences in a prediction's main solve")
+#define GO_PREDICT_FORWARD_JACOBIAN 0
+#if GO_PREDICT_FORWARD_JACOBIAN
+#define GO_PREDICT_JACOBIAN_NAME "forward"
+#else
+#define GO_PREDICT_JACOBIAN_NAME "central"
+#endif
 // feasibility polish (go_solve.h): Gauss-Newton iterations at most (-), and its wall-clock cap
 // after a stop signal (s)
 #define GO_POLISH_ITER 200

@@ -4,6 +4,9 @@
 
 #include <coin/IpStdCInterface.h>
 #include <ctype.h>
+#ifdef __GLIBC__
+#include <malloc.h>
+#endif
 #include <errno.h>
 #include <math.h>
 #include <signal.h>
@@ -487,6 +490,32 @@ const char* go_solve_status_str(go_solve_status st) {
   return "unknown status";
 }
 
+// --- the heap during a solve ---------------------------------------------------------------------
+
+// MUMPS allocates its factorisation workspace anew at every factorisation (at 80 nodes about
+// 1.3 GB of address space with Ipopt's mumps_mem_percent of 1000, of which a part is touched), and glibc serves a block that large by mmap and returns it by munmap. Each
+// iteration then pays the kernel's zeroing of every page MUMPS touches: at 80 nodes a quarter of
+// a prediction's iteration went to page faults and the first touches of the fronts' memset
+// (docs/BENCHMARKS.md, "The heap kept during a solve"). During the solve glibc serves every
+// block from its heap and keeps freed memory there, so the pages stay mapped from one
+// factorisation to the next; afterwards the defaults return and the heap is trimmed. Only where
+// and when the memory lives changes, not a value: the iterates are bitwise the same.
+static void heap_keep_during_solve(int keep) {
+#ifdef __GLIBC__
+  if (keep) {
+    mallopt(M_MMAP_MAX, 0);
+    mallopt(M_TRIM_THRESHOLD, -1);  // never trim (mallopt(3)); a finite threshold below the
+                                    // workspace's size still returns it at every free
+  } else {
+    mallopt(M_MMAP_MAX, 65536);             // glibc's default
+    mallopt(M_TRIM_THRESHOLD, 128 * 1024);  // glibc's default
+    malloc_trim(0);
+  }
+#else
+  (void)keep;
+#endif
+}
+
 // --- solve --------------------------------------------------------------------------------------
 
 int go_ipopt_solve(go_nlp* nlp, const go_ipopt_opts* opts, double* z, double* z_best,
@@ -591,13 +620,15 @@ int go_ipopt_solve(go_nlp* nlp, const go_ipopt_opts* opts, double* z, double* z_
   double cpu0 = cpu_now();
   clock_gettime(CLOCK_MONOTONIC, &s.t0);
   double fobj = 0.0;
+  heap_keep_during_solve(1);
   int st = IpoptSolve(p, x, NULL, &fobj, mult ? mult->g : NULL, mult ? mult->z_l : NULL,
                       mult ? mult->z_u : NULL, &s);
-  res->wall_s = elapsed(&s.t0);
-  res->cpu_s = cpu_now() - cpu0;
   if (own_handlers)
     for (int i = 0; i < 3; i++) sigaction(kStopSignals[i], &old_sa[i], NULL);
   FreeIpoptProblem(p);
+  heap_keep_during_solve(0);
+  res->wall_s = elapsed(&s.t0);
+  res->cpu_s = cpu_now() - cpu0;
 
   // the returned point: objective, violation, and a candidate for the best iterate
   res->ipopt_status = st;

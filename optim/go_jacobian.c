@@ -30,10 +30,33 @@ static int node_jac(go_nlp* nlp, int w, int k, const double* zs, double* vals) {
         for (int p = cp[j]; p < cp[j + 1]; p++) vals[p] = wk->jv[p];
   }
 
-  // one pair of evaluations per colour group: its columns share no row
   memcpy(wk->zp, wk->z, sizeof(double) * (size_t)nz);
   memcpy(wk->zm, wk->z, sizeof(double) * (size_t)nz);
-  for (int g = 0; g < nlp->ngroup; g++) {
+  if (nlp->mode == GO_JAC_SPARSE_FORWARD && nlp->ngroup > 0) {
+    // the base point, then one evaluation per colour group, the last group first: the groups
+    // of speeds and other non-coordinate columns come last in the layout, so they follow the
+    // base point at its coordinates and reuse its position stage (go_gait.c, node_inverse)
+    wk->path_evals++;
+    if (nlp->prob.path(ctx, k, wk->z, wk->gm) != 0) return 1;
+    for (int g = nlp->ngroup - 1; g >= 0; g--) {
+      int c0 = nlp->grp_ptr[g], c1 = nlp->grp_ptr[g + 1];
+      for (int q = c0; q < c1; q++) {
+        int j = nlp->grp_col[q];
+        wk->zp[j] = wk->z[j] + go_fd_step_forward(zk[j]) * nlp->zscale[j];
+      }
+      wk->path_evals++;
+      if (nlp->prob.path(ctx, k, wk->zp, wk->gp) != 0) return 1;
+      for (int q = c0; q < c1; q++) {
+        int j = nlp->grp_col[q];
+        double inv = 1.0 / (wk->zp[j] - wk->z[j]);  // exact representable step
+        for (int p = cp[j]; p < cp[j + 1]; p++) vals[p] = (wk->gp[ri[p]] - wk->gm[ri[p]]) * inv;
+        wk->zp[j] = wk->z[j];
+      }
+    }
+  }
+
+  // central differences: one pair of evaluations per colour group (its columns share no row)
+  for (int g = 0; g < nlp->ngroup && nlp->mode != GO_JAC_SPARSE_FORWARD; g++) {
     int c0 = nlp->grp_ptr[g], c1 = nlp->grp_ptr[g + 1];
     for (int q = c0; q < c1; q++) {
       int j = nlp->grp_col[q];

@@ -107,6 +107,12 @@ static inline double go_fd_step(double zs) {
   return 6.0554544523933395e-06 * (a > 1.0 ? a : 1.0);
 }
 
+// forward-difference step in scaled variables: sqrt(eps) max(1, |zs|)
+static inline double go_fd_step_forward(double zs) {
+  double a = zs < 0 ? -zs : zs;
+  return 1.4901161193847656e-08 * (a > 1.0 ? a : 1.0);
+}
+
 // shared by both files
 int go_nlp_node_g(go_nlp* nlp, int w, int k, const double* zs, double* g);
 int go_nlp_node_L(go_nlp* nlp, int w, int k, const double* zs, double* L);

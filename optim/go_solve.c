@@ -57,6 +57,7 @@ void go_solve_plan_default(go_solve_plan* p) {
   p->ipopt.fallback_rise = GO_FALLBACK_RISE;
   p->ipopt.fallback_viol = GO_FALLBACK_VIOL;
   p->hessian = GO_HESSIAN_LBFGS;
+  p->main_jacobian = GO_JAC_SPARSE;
   p->gn_mu_init = GO_GN_MU_INIT;
   p->min_hess_perturbation = GO_MIN_HESS_PERTURBATION;
   p->max_iter = -1;
@@ -507,8 +508,10 @@ static int run_stages(run_state* s, go_solve_report* rep, char* err, int errsz) 
     opts.handover_viol = opts.best_viol_tol;
   }
   memcpy(s->z, p->z0, sizeof(double) * (size_t)s->n);
-  if (main_solve(s, &opts, rep, err, errsz) != 0 || refine(s, &opts, rep, err, errsz) != 0)
-    return -1;
+  go_nlp_set_jac_mode(s->nlp, p->main_jacobian);
+  int main_rc = main_solve(s, &opts, rep, err, errsz);
+  go_nlp_set_jac_mode(s->nlp, GO_JAC_SPARSE);
+  if (main_rc != 0 || refine(s, &opts, rep, err, errsz) != 0) return -1;
   if (s->lam && f) print_largest_multipliers(f, s->g, s->lam, p->label);
   // the point chosen: Ipopt's when it converged, else the best iterate; then its polish
   rep->converged = solve_converged(&rep->result);

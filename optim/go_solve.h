@@ -67,6 +67,9 @@ typedef struct {
                               // order); max_iter, max_wall_s, progress, handle_sigint and hess
                               // are set from the fields below
   go_hessian_kind hessian;    // Hessian of the main solve
+  go_jac_mode main_jacobian;  // how the main solve and its restarts differentiate the path rows
+                              // (GO_JAC_SPARSE: central, GO_JAC_SPARSE_FORWARD: forward
+                              // differences); the refinement and the polish use central ones
   double gn_mu_init;          // a Gauss-Newton main solve's initial barrier parameter (Ipopt's
                               // mu_init, -), placed before the caller's options so that theirs
                               // wins; <= 0: Ipopt's default (0.1)

@@ -314,6 +314,42 @@ int main(void) {
   printf("jacobian: %d entries, worst relative error %.2e, largest dense FD value outside the "
          "pattern %.1e; fibre rows: %d entries, worst relative error %.2e\n", ne, worst, worst_out,
          n_fib, worst_fib);
+
+  // forward differences (GO_JAC_SPARSE_FORWARD, a prediction's main solve): per node one
+  // evaluation at the base point and one per colour group, 2 nv + 1 instead of 4 nv. The base
+  // point and the nv qdot groups, evaluated first, run at the node's own coordinates, where the
+  // analytic columns left the position stage: nv + 1 reuses per node. Accuracy against the same
+  // dense central differences: 3e-4 relative (its truncation error, h |g''| / 2: up to 1.4e-4 seen,
+  // in a pelvis coordinate's column) plus 1e-6 absolute, its rounding noise (eps |g| / sqrt(eps) =
+  // 1.5e-8 |g|; 3e-7 seen)
+  {
+    double* Jf = malloc(sizeof(double) * (size_t)ne);
+    go_nlp_set_jac_mode(a, GO_JAC_SPARSE_FORWARD);
+    go_nlp_reset_counts(a);
+    long r0 = go_gait_position_reuses(g1);
+    EXPECT_EQ_INT(0, go_nlp_eval_jac(a, zs, Jf));
+    go_eval_counts cf;
+    go_nlp_counts(a, &cf);
+    EXPECT_EQ_INT(4L * (2 * L->nv + 1), cf.path_evals_last_jac);
+    EXPECT_EQ_INT(4L * (L->nv + 1), go_gait_position_reuses(g1) - r0);
+    go_nlp_set_jac_mode(a, GO_JAC_SPARSE);
+    int bad_fwd = 0;
+    double worst_fwd = 0, worst_fwd_abs = 0;
+    for (int e = 0; e < ne; e++) {
+      double ex = D[(size_t)ir[e] * n + jc[e]];
+      double dev = fabs(Jf[e] - ex);
+      if (fabs(ex) > 1e-2) worst_fwd = fmax(worst_fwd, dev / fabs(ex));
+      worst_fwd_abs = fmax(worst_fwd_abs, dev);
+      if (dev > 3e-4 * fabs(ex) + 1e-6 && bad_fwd++ < 8)
+        fprintf(stderr, "forward jac entry %d (row %d, col %d = var %d): expected %.10g actual "
+                "%.10g\n", e, ir[e], jc[e], jc[e] % L->nz, ex, Jf[e]);
+    }
+    EXPECT_EQ_INT(0, bad_fwd);
+    printf("forward-difference Jacobian: %ld path evaluations (central %ld), worst relative error "
+           "of entries > 1e-2 %.2e, worst absolute error %.1e\n", cf.path_evals_last_jac,
+           cnt.path_evals_last_jac, worst_fwd, worst_fwd_abs);
+    free(Jf);
+  }
   int bad_grad = 0;
   for (int v = 0; v < n; v++) {
     double ex = Dg[v];

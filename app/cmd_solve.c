@@ -1006,14 +1006,13 @@ int gs_cmd_predict(int argc, char** argv) {
         bad = gs_opt_real("--metabolic-smoothing", optarg, 0, 1e3, GS_OPT_LO_OPEN,
                           &o.metabolic_smoothing);
         break;
-      case 'J':
-        if (!strcmp(optarg, "forward") || !strcmp(optarg, "central")) {
-          o.plan.main_jacobian = optarg[0] == 'f' ? GO_JAC_SPARSE_FORWARD : GO_JAC_SPARSE;
-        } else {
-          fprintf(stderr, "gaitsim: --jacobian: '%s' is neither forward nor central\n", optarg);
-          bad = 1;
-        }
+      case 'J': {
+        static const char* const jacobians[] = {"forward", "central", NULL};
+        int k = 0;
+        bad = gs_opt_choice("--jacobian", optarg, jacobians, &k);
+        if (!bad) o.plan.main_jacobian = k == 0 ? GO_JAC_SPARSE_FORWARD : GO_JAC_SPARSE;
         break;
+      }
       case 'p':
         if (go_ipopt_opts_add(&o.plan.ipopt, optarg, err, sizeof(err)) != 0) {
           fprintf(stderr, "gaitsim: --ipopt: %s\n", err);

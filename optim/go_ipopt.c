@@ -493,13 +493,14 @@ const char* go_solve_status_str(go_solve_status st) {
 // --- the heap during a solve ---------------------------------------------------------------------
 
 // MUMPS allocates its factorisation workspace anew at every factorisation (at 80 nodes about
-// 1.3 GB of address space with Ipopt's mumps_mem_percent of 1000, of which a part is touched), and glibc serves a block that large by mmap and returns it by munmap. Each
-// iteration then pays the kernel's zeroing of every page MUMPS touches: at 80 nodes a quarter of
-// a prediction's iteration went to page faults and the first touches of the fronts' memset
-// (docs/BENCHMARKS.md, "The heap kept during a solve"). During the solve glibc serves every
-// block from its heap and keeps freed memory there, so the pages stay mapped from one
-// factorisation to the next; afterwards the defaults return and the heap is trimmed. Only where
-// and when the memory lives changes, not a value: the iterates are bitwise the same.
+// 1.3 GB of address space with Ipopt's mumps_mem_percent of 1000, of which a part is touched),
+// and glibc serves a block that large by mmap and returns it by munmap. Each iteration then pays
+// the kernel's zeroing of every page MUMPS touches: at 80 nodes a quarter of a prediction's
+// iteration went to page faults and the first touches of the fronts' memset (docs/BENCHMARKS.md,
+// "Lever kept: the heap kept during a solve"). During the solve glibc serves every block from
+// its heap and keeps freed memory there, so the pages stay mapped from one factorisation to the
+// next; afterwards the defaults return and the heap is trimmed. Only where and when the memory
+// lives changes, not a value: the iterates are bitwise the same.
 static void heap_keep_during_solve(int keep) {
 #ifdef __GLIBC__
   if (keep) {

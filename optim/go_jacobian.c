@@ -30,43 +30,31 @@ static int node_jac(go_nlp* nlp, int w, int k, const double* zs, double* vals) {
         for (int p = cp[j]; p < cp[j + 1]; p++) vals[p] = wk->jv[p];
   }
 
+  // per colour group (its columns share no row) a pair of evaluations, z + h and z - h (central
+  // differences), or one, z + h, against the base point z evaluated once (forward differences;
+  // zm stays z). Forward, the groups go last first: the groups of speeds and other
+  // non-coordinate columns come last in the layout, so they follow the base point at its
+  // coordinates and reuse its position stage (go_gait.c, node_inverse)
+  int fwd = nlp->mode == GO_JAC_SPARSE_FORWARD;
   memcpy(wk->zp, wk->z, sizeof(double) * (size_t)nz);
   memcpy(wk->zm, wk->z, sizeof(double) * (size_t)nz);
-  if (nlp->mode == GO_JAC_SPARSE_FORWARD && nlp->ngroup > 0) {
-    // the base point, then one evaluation per colour group, the last group first: the groups
-    // of speeds and other non-coordinate columns come last in the layout, so they follow the
-    // base point at its coordinates and reuse its position stage (go_gait.c, node_inverse)
+  if (fwd && nlp->ngroup > 0) {
     wk->path_evals++;
     if (nlp->prob.path(ctx, k, wk->z, wk->gm) != 0) return 1;
-    for (int g = nlp->ngroup - 1; g >= 0; g--) {
-      int c0 = nlp->grp_ptr[g], c1 = nlp->grp_ptr[g + 1];
-      for (int q = c0; q < c1; q++) {
-        int j = nlp->grp_col[q];
-        wk->zp[j] = wk->z[j] + go_fd_step_forward(zk[j]) * nlp->zscale[j];
-      }
-      wk->path_evals++;
-      if (nlp->prob.path(ctx, k, wk->zp, wk->gp) != 0) return 1;
-      for (int q = c0; q < c1; q++) {
-        int j = nlp->grp_col[q];
-        double inv = 1.0 / (wk->zp[j] - wk->z[j]);  // exact representable step
-        for (int p = cp[j]; p < cp[j + 1]; p++) vals[p] = (wk->gp[ri[p]] - wk->gm[ri[p]]) * inv;
-        wk->zp[j] = wk->z[j];
-      }
-    }
   }
-
-  // central differences: one pair of evaluations per colour group (its columns share no row)
-  for (int g = 0; g < nlp->ngroup && nlp->mode != GO_JAC_SPARSE_FORWARD; g++) {
+  for (int i = 0; i < nlp->ngroup; i++) {
+    int g = fwd ? nlp->ngroup - 1 - i : i;
     int c0 = nlp->grp_ptr[g], c1 = nlp->grp_ptr[g + 1];
     for (int q = c0; q < c1; q++) {
       int j = nlp->grp_col[q];
-      double hs = go_fd_step(zk[j]) * nlp->zscale[j];  // step in physical units
+      // step in physical units
+      double hs = (fwd ? go_fd_step_forward(zk[j]) : go_fd_step(zk[j])) * nlp->zscale[j];
       wk->zp[j] = wk->z[j] + hs;
-      wk->zm[j] = wk->z[j] - hs;
+      if (!fwd) wk->zm[j] = wk->z[j] - hs;
     }
-    wk->path_evals += 2;
+    wk->path_evals += fwd ? 1 : 2;
     if (nlp->prob.path(ctx, k, wk->zp, wk->gp) != 0) return 1;
-    if (nlp->prob.path(ctx, k, wk->zm, wk->gm) != 0) return 1;
+    if (!fwd && nlp->prob.path(ctx, k, wk->zm, wk->gm) != 0) return 1;
     for (int q = c0; q < c1; q++) {
       int j = nlp->grp_col[q];
       double inv = 1.0 / (wk->zp[j] - wk->zm[j]);  // exact representable step

@@ -35,8 +35,8 @@ static const char* kRunUsage =
     "     the exact Hessian until the objective settles (gaitsim track --refine); polished to a\n"
     "     dynamically consistent point;\n"
     "  2. DIR/sweep/predict_V: predictive solves at the speeds of LIST (default 0.8,2.0: 0.8 and\n"
-    "     2.0 m/s, each started from the tracking solution as in the paper, in two\n"
-    "     processes; a longer LIST is solved by continuation, gaitsim sweep), DIR/sweep/sweep.md;\n"
+    "     2.0 m/s), each started from the tracking solution as in the paper, two at once in\n"
+    "     processes of their own (gaitsim sweep), DIR/sweep/sweep.md;\n"
     "     walks: the summed vertical ground reaction stays above 0.2 BW (gaitsim predict\n"
     "     --min-vgrf; not in the paper), so no node is in flight;\n"
     "  3. DIR/*/report/: figures and report.md of every solution, DIR/sweep/report/: the speeds\n"
@@ -209,8 +209,7 @@ int gs_cmd_run(int argc, char** argv) {
   stopped_short |= rc == GS_EXIT_STOPPED_SHORT;
   if (stopped_by_signal(out)) return GS_EXIT_STOPPED_SHORT;
 
-  // 2. predictions (gaitsim sweep): each speed from the nearest one solved, for the default
-  // speeds the tracking solution
+  // 2. predictions (gaitsim sweep): each speed from the tracking solution, two at once
   char sweep_dir[4096];
   snprintf(sweep_dir, sizeof(sweep_dir), "%s/sweep", out);
   printf("[2] predictive solves at %s m/s from the tracking solution -> %s\n",

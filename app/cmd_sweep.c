@@ -1,7 +1,10 @@
-// cmd_sweep.c: `gaitsim sweep`: predictive solves over a range of speeds (issue #8) by
-// continuation: the speeds below the guess's speed are solved downwards and those above upwards,
-// each started from the nearest speed already solved (the first from the guess itself); the two
-// chains are independent and run in two processes. Writes DIR/predict_<V>/ per speed and
+// cmd_sweep.c: `gaitsim sweep`: predictive solves over a range of speeds (issue #8). By default
+// every speed starts from the guess (the tracking solution, as in Lin, Walter & Pandy 2018), so
+// the speeds are independent: they run in --jobs processes and each gives the solution `gaitsim
+// predict --guess G --speed V` gives, whatever the other speeds and the process count. With
+// --start neighbour they are solved by continuation instead: the speeds below the guess's speed
+// downwards and those above upwards, each from the nearest speed already solved (the first from
+// the guess), the two chains in two processes. Writes DIR/predict_<V>/ per speed and
 // DIR/sweep.csv and DIR/sweep.md: stride time and length, cost of transport, peak vertical ground
 // reaction and peak knee contact force of both knees per speed (right: the implant knee, the one
 // measured in vivo; left: the 1-DOF knee's joint reaction, callbacks/gs_knee_reaction.h), in BW.
@@ -26,18 +29,27 @@
 #include "optim/go_ipopt.h"
 
 #define SWEEP_MAX_SPEEDS GS_MAX_SPEEDS
+#define SWEEP_DEFAULT_JOBS 2
+#define SWEEP_MAX_JOBS 8  // go_ipopt passes stop signals on to at most 8 processes
 
 static const char* kSweepUsage =
     "usage: gaitsim sweep --guess TRACK_DIR --speeds LIST --out DIR [options]\n\n"
-    "Predictive solves (gaitsim predict) at every speed of LIST, by continuation from the nearest\n"
-    "speed already solved; speeds below and above the guess's own speed run in two processes.\n"
+    "Predictive solves (gaitsim predict) at every speed of LIST, each started from TRACK_DIR\n"
+    "(the tracking solution), in --jobs processes; each speed's solution is the one\n"
+    "`gaitsim predict --guess TRACK_DIR --speed V --threads 1` gives. With --start neighbour,\n"
+    "by continuation instead: each speed from the nearest speed already solved, those below\n"
+    "and above the guess's own speed in two processes.\n"
     "LIST is A:STEP:B (m/s, e.g. 0.8:0.2:2.0) or comma-separated speeds. Writes DIR/predict_V/\n"
     "(the solver's progress in DIR/predict_V/log.txt), DIR/sweep.csv and DIR/sweep.md.\n"
     "DIR is written whole: into .DIR.tmp.XXXXXX beside it, which replaces DIR at the end (an\n"
     "existing DIR only when it holds an earlier sweep, sweep.csv). A stop signal (SIGINT,\n"
-    "SIGTERM, SIGHUP) reaches both processes: the running solves write their best iterates and\n"
+    "SIGTERM, SIGHUP) reaches every process: the running solves write their best iterates and\n"
     "DIR holds the speeds solved, the table saying which were not (exit 3); a second signal\n"
     "ends the sweep at once and DIR stays as it was. No speed solved: DIR stays as it was.\n\n"
+    "  --start guess|neighbour  where each speed starts (default guess: the tracking solution)\n"
+    "  --jobs P        solves at once with --start guess, 1-" GO_STR(SWEEP_MAX_JOBS)
+    " (default " GO_STR(SWEEP_DEFAULT_JOBS) "; one\n"
+    "                  thread each)\n"
     "  --nodes N       collocation nodes (default: the guess's, as gaitsim predict)\n"
     "  --max-time S    wall-clock limit of each solve, s (default none: the iteration limit,\n"
     "                  so that the results do not depend on the load of the machine)\n"
@@ -140,13 +152,80 @@ static int chain(const char* guess, const double* v, const int* idx, int n, cons
   return worst;
 }
 
+// solve the speeds v[0..n) each from guess, at most jobs at once, each in a process of its own.
+// A stop signal (passed on to the running solves) starts no further speed; a failed speed does
+// not stop the others. Returns the first failure, else GS_EXIT_STOPPED_SHORT when a solve stopped
+// short or a speed was not started, else GS_EXIT_OK.
+static int from_guess(const char* guess, const double* v, int n, int jobs, const char* dir,
+                      const char* nodes, const char* max_time, const char* max_iter) {
+  pid_t running[SWEEP_MAX_JOBS] = {0};
+  int nrun = 0, next = 0, failed = GS_EXIT_OK, stopped_short = 0;
+  sigset_t stops, before;
+  sigemptyset(&stops);
+  sigaddset(&stops, SIGINT);
+  sigaddset(&stops, SIGTERM);
+  sigaddset(&stops, SIGHUP);
+  while (next < n || nrun > 0) {
+    if (next < n && nrun < jobs && go_ipopt_stop_signals() == 0) {
+      char out[4096];
+      snprintf(out, sizeof(out), "%s/predict_%.4g", dir, v[next]);
+      // stop signals held back until the child is registered; the child forgets its siblings
+      // (they have their signal from this process)
+      sigprocmask(SIG_BLOCK, &stops, &before);
+      fflush(stdout);
+      fflush(stderr);
+      pid_t pid = fork();
+      if (pid == 0) {
+        for (int k = 0; k < nrun; k++) go_ipopt_forward_signals_to((long)running[k], 0);
+        sigprocmask(SIG_SETMASK, &before, NULL);
+        _exit(solve_one(guess, v[next], out, nodes, max_time, max_iter));
+      }
+      if (pid > 0) {
+        go_ipopt_forward_signals_to((long)pid, 1);
+        running[nrun++] = pid;
+      }
+      sigprocmask(SIG_SETMASK, &before, NULL);
+      if (pid < 0) {
+        fprintf(stderr, "gaitsim: sweep: %.4g m/s: fork: %s\n", v[next], strerror(errno));
+        if (failed == GS_EXIT_OK) failed = GS_EXIT_FAILURE;
+      }
+      next++;
+      continue;
+    }
+    if (nrun == 0) break;  // stopped by a signal with nothing running
+    int st = 0;
+    pid_t pid = waitpid(-1, &st, 0);
+    if (pid < 0) {
+      if (errno == EINTR) continue;
+      break;
+    }
+    for (int k = 0; k < nrun; k++)
+      if (running[k] == pid) {
+        go_ipopt_forward_signals_to((long)pid, 0);
+        running[k] = running[--nrun];
+        int rc = WIFEXITED(st) ? WEXITSTATUS(st) : GS_EXIT_FAILURE;
+        if (rc == GS_EXIT_STOPPED_SHORT) stopped_short = 1;
+        else if (rc != GS_EXIT_OK && failed == GS_EXIT_OK) failed = rc;
+        break;
+      }
+  }
+  if (next < n) {
+    printf("sweep: stopped by a signal before %.4g m/s\n", v[next]);
+    stopped_short = 1;
+  }
+  return failed != GS_EXIT_OK ? failed : stopped_short ? GS_EXIT_STOPPED_SHORT : GS_EXIT_OK;
+}
+
 int gs_cmd_sweep(int argc, char** argv) {
   static const struct option options[] = {
       {"guess", required_argument, NULL, 'g'},   {"speeds", required_argument, NULL, 's'},
       {"out", required_argument, NULL, 'o'},     {"nodes", required_argument, NULL, 'n'},
       {"max-time", required_argument, NULL, 'T'}, {"max-iter", required_argument, NULL, 'i'},
+      {"start", required_argument, NULL, 'S'},   {"jobs", required_argument, NULL, 'j'},
       {"help", no_argument, NULL, 'h'},
       {NULL, 0, NULL, 0}};
+  static const char* const starts[] = {"guess", "neighbour", NULL};
+  int start = 0, jobs = SWEEP_DEFAULT_JOBS;
   const char *guess = NULL, *dir = NULL, *nodes = NULL, *max_time = NULL;
   const char* max_iter = GO_STR(GO_MAX_ITER);
   double v[SWEEP_MAX_SPEEDS];
@@ -154,7 +233,7 @@ int gs_cmd_sweep(int argc, char** argv) {
   optind = 1;
   opterr = 0;
   // every value checked here; predict gets the words as given
-  while (!bad && (c = getopt_long(argc, argv, ":g:s:o:n:T:i:h", options, NULL)) != -1) {
+  while (!bad && (c = getopt_long(argc, argv, ":g:s:o:n:T:i:S:j:h", options, NULL)) != -1) {
     switch (c) {
       case 'g': guess = optarg; break;
       case 's': bad = (n = gs_opt_speeds("--speeds", optarg, v)) < 0; break;
@@ -162,6 +241,8 @@ int gs_cmd_sweep(int argc, char** argv) {
       case 'n': bad = gs_opt_solve_limit(c, optarg, &nodes); break;
       case 'T': bad = gs_opt_solve_limit(c, optarg, &max_time); break;
       case 'i': bad = gs_opt_solve_limit(c, optarg, &max_iter); break;
+      case 'S': bad = gs_opt_choice("--start", optarg, starts, &start); break;
+      case 'j': bad = gs_opt_int("--jobs", optarg, 1, SWEEP_MAX_JOBS, &jobs); break;
       case 'h': fputs(kSweepUsage, stdout); return GS_EXIT_OK;
       default: return gs_opt_getopt_error("sweep", c, argv);
     }
@@ -193,36 +274,43 @@ int gs_cmd_sweep(int argc, char** argv) {
   }
   const char* final_dir = dir;
   dir = tx.staging;
-  // the chains: downwards from the guess's speed, upwards from it
-  int down[SWEEP_MAX_SPEEDS], up[SWEEP_MAX_SPEEDS], nd = 0, nu = 0;
-  for (int i = n - 1; i >= 0; i--)
-    if (v[i] < v0) down[nd++] = i;
-  for (int i = 0; i < n; i++)
-    if (v[i] >= v0) up[nu++] = i;
-  printf("sweep: %d speeds around the guess's %.3f m/s: %d downwards, %d upwards\n", n, v0, nd,
-         nu);
-  fflush(stdout);
-  int rc_down = GS_EXIT_OK, rc_up;
-  // stop signals reach both chains: held back until the child is registered
-  sigset_t stops, before;
-  sigemptyset(&stops);
-  sigaddset(&stops, SIGINT);
-  sigaddset(&stops, SIGTERM);
-  sigaddset(&stops, SIGHUP);
-  sigprocmask(SIG_BLOCK, &stops, &before);
-  pid_t pid = nd > 0 && nu > 0 ? fork() : -1;
-  if (pid > 0) go_ipopt_forward_signals_to((long)pid, 1);
-  sigprocmask(SIG_SETMASK, &before, NULL);
-  if (pid == 0) _exit(chain(guess, v, down, nd, dir, nodes, max_time, max_iter));
-  rc_up = chain(guess, v, up, nu, dir, nodes, max_time, max_iter);
-  if (pid > 0) {
-    int st = 0;
-    while (waitpid(pid, &st, 0) < 0 && errno == EINTR) {
+  int rc_down = GS_EXIT_OK, rc_up = GS_EXIT_OK;
+  if (start == 0) {
+    printf("sweep: %d speeds, each from the guess (%.3f m/s), %d at once\n", n, v0,
+           jobs < n ? jobs : n);
+    fflush(stdout);
+    rc_up = from_guess(guess, v, n, jobs, dir, nodes, max_time, max_iter);
+  } else {
+    // the chains: downwards from the guess's speed, upwards from it
+    int down[SWEEP_MAX_SPEEDS], up[SWEEP_MAX_SPEEDS], nd = 0, nu = 0;
+    for (int i = n - 1; i >= 0; i--)
+      if (v[i] < v0) down[nd++] = i;
+    for (int i = 0; i < n; i++)
+      if (v[i] >= v0) up[nu++] = i;
+    printf("sweep: %d speeds around the guess's %.3f m/s by continuation: %d downwards, %d "
+           "upwards\n", n, v0, nd, nu);
+    fflush(stdout);
+    // stop signals reach both chains: held back until the child is registered
+    sigset_t stops, before;
+    sigemptyset(&stops);
+    sigaddset(&stops, SIGINT);
+    sigaddset(&stops, SIGTERM);
+    sigaddset(&stops, SIGHUP);
+    sigprocmask(SIG_BLOCK, &stops, &before);
+    pid_t pid = nd > 0 && nu > 0 ? fork() : -1;
+    if (pid > 0) go_ipopt_forward_signals_to((long)pid, 1);
+    sigprocmask(SIG_SETMASK, &before, NULL);
+    if (pid == 0) _exit(chain(guess, v, down, nd, dir, nodes, max_time, max_iter));
+    rc_up = chain(guess, v, up, nu, dir, nodes, max_time, max_iter);
+    if (pid > 0) {
+      int st = 0;
+      while (waitpid(pid, &st, 0) < 0 && errno == EINTR) {
+      }
+      go_ipopt_forward_signals_to((long)pid, 0);
+      rc_down = WIFEXITED(st) ? WEXITSTATUS(st) : GS_EXIT_FAILURE;
+    } else if (nd > 0) {
+      rc_down = chain(guess, v, down, nd, dir, nodes, max_time, max_iter);
     }
-    go_ipopt_forward_signals_to((long)pid, 0);
-    rc_down = WIFEXITED(st) ? WEXITSTATUS(st) : GS_EXIT_FAILURE;
-  } else if (nd > 0) {
-    rc_down = chain(guess, v, down, nd, dir, nodes, max_time, max_iter);
   }
 
   // the table; changes against the guess (the tracking solution: the paper's comparison) and the

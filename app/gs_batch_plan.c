@@ -519,15 +519,22 @@ static int load(gsBatchPlan* p, const cJSON* root, char* err, int errsz) {
       return -1;
     }
     cJSON_ArrayForEach(v, e) {
-      static const char* keys[] = {"name", "track", "predict", "sweep", "guess",
+      static const char* keys[] = {"name", "track", "predict", "sweep", "start", "guess",
                                    "depends", "options", "slurm"};
       int known = 0;
-      for (int k = 0; k < 8; k++) known |= !strcmp(v->string, keys[k]);
+      for (int k = 0; k < 9; k++) known |= !strcmp(v->string, keys[k]);
       if (!known) {
         gs_error_set(err, errsz, "solves[%d].%s: unknown key (name, track, predict, sweep, "
-                     "guess, depends, options, slurm)", idx, v->string);
+                     "start, guess, depends, options, slurm)", idx, v->string);
         return -1;
       }
+    }
+    const cJSON* st = cJSON_GetObjectItemCaseSensitive(e, "start");
+    if (st && (!sw || !cJSON_IsString(st) || (strcmp(st->valuestring, "guess") &&
+                                              strcmp(st->valuestring, "neighbour")))) {
+      gs_error_set(err, errsz, "solves[%d].start: \"guess\" or \"neighbour\" expected, with a "
+                   "\"sweep\"", idx);
+      return -1;
     }
     snprintf(field, sizeof(field), "solves[%d].options", idx);
     if (check_options(cJSON_GetObjectItemCaseSensitive(e, "options"),
@@ -574,7 +581,7 @@ static int load(gsBatchPlan* p, const cJSON* root, char* err, int errsz) {
     gs_error_set(err, errsz, "out of memory");
     return -1;
   }
-  // the solves, a sweep's speeds in its order (each the next one's guess); names unique
+  // the solves, a sweep's speeds in its order; names unique
   const char** init = (const char**)calloc((size_t)n, sizeof(char*));
   int k = 0, rc = -1;
   idx = 0;
@@ -601,13 +608,16 @@ static int load(gsBatchPlan* p, const cJSON* root, char* err, int errsz) {
     }
     idx++;
   }
-  // references: guess / init (a solve of the plan or a folder), a sweep's chain, depends
+  // references: guess / init (a solve of the plan or a folder; every speed of a sweep from its
+  // guess, or with "start": "neighbour" each from the speed before), depends
   k = 0;
   idx = 0;
   cJSON_ArrayForEach(e, solves) {
     const cJSON* sw = cJSON_GetObjectItemCaseSensitive(e, "sweep");
     const cJSON* g = cJSON_GetObjectItemCaseSensitive(e, "guess");
     const cJSON* dep = cJSON_GetObjectItemCaseSensitive(e, "depends");
+    const cJSON* st = cJSON_GetObjectItemCaseSensitive(e, "start");
+    int chained = cJSON_IsString(st) && !strcmp(st->valuestring, "neighbour");
     int m = sw ? cJSON_GetArraySize(sw) : 1;
     if (dep && !cJSON_IsArray(dep)) {
       gs_error_set(err, errsz, "solves[%d].depends: a list of solve names expected", idx);
@@ -615,7 +625,7 @@ static int load(gsBatchPlan* p, const cJSON* root, char* err, int errsz) {
     }
     for (int q = 0; q < m; q++, k++) {
       gsBatchSolve* s = &p->solve[k];
-      if (q > 0) {  // a sweep's next speed continues from the one before
+      if (q > 0 && chained) {  // "start": "neighbour": from the speed before
         s->from = k - 1;
         if (add_dep(s, k - 1)) goto done;
       } else if (g && resolve_from(p, solves, s, g->valuestring, "guess", err, errsz)) {

@@ -1,5 +1,5 @@
 // gs_batch_plan.h: a batch plan (issue #22): the solves of `gaitsim batch PLAN.json`, read from
-// JSON, sweeps expanded to their continuation chains, and validated whole before anything runs.
+// JSON, sweeps expanded to one predict per speed, and validated whole before anything runs.
 //
 // A plan (relative paths are taken from the plan's own folder):
 //   {"model": "mjmodels/gait2d.xml",              optional: --model of every solve
@@ -8,7 +8,9 @@
 //    "solves": [
 //      {"name": "og5", "track": "mjmodels/trials/jw_ngait_og5", "options": {"refine": 0}},
 //      {"name": "fast", "predict": 1.6, "guess": "og5"},
-//      {"name": "up", "sweep": [1.4, 1.6], "guess": "og5"},       up_1.4, then up_1.6 from it
+//      {"name": "up", "sweep": [1.4, 1.6], "guess": "og5"},       up_1.4 and up_1.6, each from og5
+//      {"name": "ch", "sweep": [1.4, 1.6], "guess": "og5", "start": "neighbour"},
+//                                                    ch_1.4 from og5, then ch_1.6 from ch_1.4
 //      {"name": "t2", "track": "trial2", "init": "og5", "depends": ["fast"]}]}
 // A solve's "options" are the long options of its command without the dashes (numbers, strings,
 // true for a flag, a list for a repeatable one: "weight": ["grf=5", "joint=2"]) and replace the

@@ -10,7 +10,7 @@ const gsCommand gs_commands[] = {
     {"inspect", gs_cmd_inspect, "one row per muscle at one instant: lengths, force, metabolics, moment arms"},
     {"track", gs_cmd_track, "tracking solve of one stride by direct collocation"},
     {"predict", gs_cmd_predict, "predictive solve at a new speed: minimum cost of transport, free stride time"},
-    {"sweep", gs_cmd_sweep, "predictive solves over a range of speeds by continuation"},
+    {"sweep", gs_cmd_sweep, "predictive solves over a range of speeds, each from the tracking solution"},
     {"batch", gs_cmd_batch, "many solves from a plan, here (--local N) or on Slurm (--slurm)"},
     {"batch-status", gs_cmd_batch_status, "done / running / pending / failed per solve of a batch"},
     {"render", gs_cmd_render, "headless gait video, picture or filmstrip of a solution (OSMesa)"},

@@ -274,15 +274,16 @@ check "two SIGTERMs: ended by SIGTERM (status $status)" test "$status" -eq 143
 check "two SIGTERMs: the earlier result untouched" test "$before" = "$(snap twice)"
 check "two SIGTERMs: no temporary folder" no_tmp twice
 
-# sweep: one SIGTERM reaches both chains (the second process gets it from the first); each
+# sweep: one SIGTERM reaches both running solves (each process gets it from the sweep's); each
 # writes its interrupted solve, no further speed starts, the table is written, exit 3; the sweep
-# replaces an earlier one whole (its predict_V of another speed does not stay)
+# replaces an earlier one whole (its predict_V of another speed does not stay). Two at once
+# (--jobs 2, the default), in ascending order: the two lowest speeds are the ones interrupted.
 read -r down1 down2 up1 up2 < <(/usr/bin/python3 -c '
 import json, sys; v = json.load(open(sys.argv[1]))["speed_mps"]
 print("%.2f %.2f %.2f %.2f" % (v - 0.3, v - 0.4, v + 0.3, v + 0.4))' sol/summary.json)
 "$gaitsim" sweep --guess sol --speeds "$up2" --out sw --nodes 6 --max-iter 2 >/dev/null 2>&1
 check "earlier sweep: written" test -f sw/sweep.csv -a "$(ls -d sw/predict_* | wc -l)" -eq 1
-sweep_and_signal() {  # OUT SIGNAL [SIGNAL2]: a 4-speed sweep, signals once both chains iterate
+sweep_and_signal() {  # OUT SIGNAL [SIGNAL2]: a 4-speed sweep, signals once two solves iterate
   "$gaitsim" sweep --guess sol --speeds "$down2,$down1,$up1,$up2" --out "$1" --nodes 10 \
     --max-iter 3000 >"$1.out" 2>"$1.err" &
   local pid=$! i
@@ -303,7 +304,7 @@ sweep_and_signal() {  # OUT SIGNAL [SIGNAL2]: a 4-speed sweep, signals once both
 sweep_and_signal sw TERM
 status=$?
 check "sweep SIGTERM: exit 3 (got $status)" test "$status" -eq 3
-for v in $down1 $up1; do
+for v in $down2 $down1; do
   v=$(/usr/bin/python3 -c 'import sys; print("%.4g" % float(sys.argv[1]))' "$v")
   check "sweep SIGTERM: predict_$v interrupted and written" \
     grep -q '"status":[[:space:]]*"interrupted"' "sw/predict_$v/summary.json"

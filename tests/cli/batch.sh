@@ -27,7 +27,7 @@ plan() {  # plan SWEEP_ITER: the test plan into plan.json
  "solves": [
   {"name": "t1", "track": "$trial"},
   {"name": "t2", "track": "$trial", "options": {"weight": ["grf=5"]}},
-  {"name": "up", "sweep": [1.2, 1.4, 1.6], "guess": "t1", "options": {"max-iter": $1}},
+  {"name": "up", "sweep": [1.2, 1.4, 1.6], "guess": "t1", "start": "neighbour", "options": {"max-iter": $1}},
   {"name": "bad", "track": "$trial", "options": {"model": "bad.xml"}},
   {"name": "after_bad", "predict": 1.2, "guess": "bad"}]}
 EOF
@@ -74,7 +74,7 @@ check "the failed solve left no folder (a solve writes its folder whole or not a
   test ! -e out/bad
 check "a solution folder holds the solve's result only (its log and record in out/logs)" \
   test "$(ls out/t1 | grep -c -e summary.json -e log.txt -e batch.json)" -eq 1 -a -f out/t1/summary.json
-check "sweep: each speed from the one before, holding its speed" /usr/bin/python3 - out <<'PY'
+check "sweep with \"start\": \"neighbour\": each speed from the one before, holding its speed" /usr/bin/python3 - out <<'PY'
 import json, os, sys
 d = os.path.realpath(sys.argv[1])
 ok = True
@@ -183,6 +183,15 @@ bad_plan "a name the batch uses itself" "solves[0].name: a name of letters, digi
   "{\"name\": \"logs\", \"track\": \"$trial\"}"
 bad_plan "unknown trial" 'solves[0].track: no trial folder (coordinates.mot, grf.mot) "nowhere"' \
   '{"name": "a", "track": "nowhere"}'
+bad_plan "bad start" 'solves[1].start: "guess" or "neighbour" expected, with a "sweep"' \
+  "$t, {\"name\": \"s\", \"sweep\": [1, 2], \"guess\": \"a\", \"start\": \"chain\"}"
+bad_plan "start without a sweep" 'solves[1].start: "guess" or "neighbour" expected, with a "sweep"' \
+  "$t, {\"name\": \"p\", \"predict\": 1, \"guess\": \"a\", \"start\": \"guess\"}"
+# a sweep's speeds start from its guess by default (as gaitsim sweep): every command --guess DIR/a
+echo "{\"solves\": [$t, {\"name\": \"s\", \"sweep\": [1, 1.5, 2], \"guess\": \"a\"}]}" >p.json
+"$gaitsim" batch p.json --check >check.txt 2>&1
+check "sweep by default: exit 0, each speed from the guess ($(grep -c -- '--guess [^ ]*/a ' check.txt) of 3)" \
+  test "$(grep -c -- '--guess [^ ]*/a ' check.txt)" -eq 3
 # the plan's option table follows the commands: every option in `gaitsim track --help` and
 # `gaitsim predict --help` is known to the plan (a wrong value is refused as a value)
 known=0 unknown=""

@@ -116,7 +116,7 @@ cat >plan.json <<EOF
  "solves": [
   {"name": "t1", "track": "$trial"},
   {"name": "t2", "track": "$trial", "options": {"weight": ["grf=5"]}},
-  {"name": "up", "sweep": [1.2, 1.4, 1.6], "guess": "t1", "options": {"max-iter": 3}},
+  {"name": "up", "sweep": [1.2, 1.4, 1.6], "guess": "t1", "start": "neighbour", "options": {"max-iter": 3}},
   {"name": "bad", "track": "$trial", "options": {"model": "bad.xml"}},
   {"name": "after_bad", "predict": 1.2, "guess": "bad"}]}
 EOF

@@ -1,10 +1,13 @@
 #!/usr/bin/env bash
 # gaitsim sweep on a tiny problem: the fixture solution (given a speed of 1.27 m/s) as the guess,
-# speeds 0.9 (below: the downward chain, in the forked process) and 1.6 (upward chain), 5 nodes,
-# 2 Ipopt iterations each; exit 3 (solves stopped short), one folder per speed with its target
-# speed and log, a table with one row per speed in ascending order and the peak knee contact of
-# both knees, and the walk columns (summed vertical GRF minimum, flight and double-support
-# nodes) as each summary.json has them; a malformed list exits 2.
+# speeds 0.9 and 1.6, 5 nodes, 2 Ipopt iterations each; exit 3 (solves stopped short), one folder
+# per speed with its target speed and log, a table with one row per speed in ascending order and
+# the peak knee contact of both knees, and the walk columns (summed vertical GRF minimum, flight
+# and double-support nodes) as each summary.json has them. Each speed starts from the guess and
+# its solution is bitwise that of `gaitsim predict` with the same words, in whichever process;
+# --start neighbour chains 1.6 -> 1.8 (and 0.9 down from the guess in the forked process); bad
+# --start, --jobs and a malformed list exit 2. Each solve's polish from its far-from-feasible
+# point takes most of the test's minute or two.
 # usage: sweep.sh GAITSIM SOURCE_DIR
 set -u
 gaitsim=$1 src=$2
@@ -61,6 +64,30 @@ for r in rows:
 sys.exit(0 if ok else 1)
 PY
 check "markdown: walk column" grep -q "lowest summed vertical GRF (BW); nodes in flight, in double support" sw/sweep.md
+# each speed from the guess: the words of gaitsim predict, bitwise its solution, any --jobs
+for v in 0.9 1.6; do
+  check "predict_$v started from the guess" grep -q '"guess":[[:space:]]*"guess"' "sw/predict_$v/summary.json"
+done
+"$gaitsim" predict --guess guess --speed 1.6 --out p16 --nodes 5 --max-iter 2 --threads 1 >/dev/null 2>&1
+check "predict_1.6: bitwise gaitsim predict's variables.sto" cmp -s sw/predict_1.6/variables.sto p16/variables.sto
+# continuation: 1.8 from 1.6 (the staging folder's predict_1.6), 0.9 and 1.6 from the guess
+"$gaitsim" sweep --guess guess --speeds 0.9,1.6,1.8 --out swn --nodes 5 --max-iter 2 --start neighbour \
+  >swn.txt 2>&1
+status=$?
+check "--start neighbour: exit 3 (got $status)" test "$status" -eq 3
+check "--start neighbour: 1.8 from predict_1.6" grep -q '"guess":[[:space:]]*"[^"]*/predict_1.6"' swn/predict_1.8/summary.json
+check "--start neighbour: 1.6 from the guess" grep -q '"guess":[[:space:]]*"guess"' swn/predict_1.6/summary.json
+check "--start neighbour: by continuation" grep -q "by continuation: 1 downwards, 2 upwards" swn.txt
+# the speeds from the guess are the same whichever process solved them (two chains here, two
+# solves at once above)
+for v in 0.9 1.6; do
+  check "--start neighbour: predict_$v bitwise the default sweep's" cmp -s "sw/predict_$v/variables.sto" "swn/predict_$v/variables.sto"
+done
 "$gaitsim" sweep --guess guess --speeds 0.8:x:2 --out sw2 >/dev/null 2>&1
 check "malformed speeds: exit 2" test $? -eq 2
+"$gaitsim" sweep --guess guess --speeds 1 --out sw2 --start middle 2>err2.txt
+check "--start middle: exit 2, one line naming it" test $? -eq 2 -a "$(grep -c -- '--start' err2.txt)" -eq 1
+"$gaitsim" sweep --guess guess --speeds 1 --out sw2 --jobs 9 2>/dev/null
+check "--jobs 9: exit 2" test $? -eq 2
+check "no sw2 written by the refused commands" test ! -e sw2
 finish

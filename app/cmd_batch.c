@@ -17,8 +17,9 @@
 static const char* kBatchUsage =
     "usage: gaitsim batch PLAN.json --out DIR [--local N | --slurm] [--check]\n\n"
     "Many solves from one plan (README \"Batches\"): tracks of trials, predictions at speeds from\n"
-    "a named solve's result, sweeps (their speeds in order, each from the one before), with the\n"
-    "options of gaitsim track / predict. The plan is checked whole first (trial and guess folders,\n"
+    "a named solve's result, sweeps (every speed from the sweep's guess; with \"start\":\n"
+    "\"neighbour\" in order, each from the one before), with the options of gaitsim track /\n"
+    "predict. The plan is checked whole first (trial and guess folders,\n"
     "every option, dependencies, cycles); on an error nothing runs. Each solve runs `gaitsim\n"
     "track` or `gaitsim predict` into its solution folder DIR/NAME/ (its progress in\n"
     "DIR/logs/NAME.log, its exit status and wall time in DIR/logs/NAME.json). Running a plan\n"

@@ -8,6 +8,7 @@ const gsCommand gs_commands[] = {
     {"info", gs_cmd_info, "summarise a model: degrees of freedom, muscles, contacts, mass"},
     {"simulate", gs_cmd_simulate, "forward simulation with gaitsim's muscles and foot contact"},
     {"inspect", gs_cmd_inspect, "one row per muscle at one instant: lengths, force, metabolics, moment arms"},
+    {"balance", gs_cmd_balance, "frontal-plane balance of a gait by inverse dynamics: feet, hips, CoM, momentum"},
     {"track", gs_cmd_track, "tracking solve of one stride by direct collocation"},
     {"predict", gs_cmd_predict, "predictive solve at a new speed: minimum cost of transport, free stride time"},
     {"sweep", gs_cmd_sweep, "predictive solves over a range of speeds, each from the tracking solution"},

@@ -1,0 +1,199 @@
+// cmd_balance.c: `gaitsim balance MODEL --pose FILE --grf FILE`: the frontal-plane balance of a
+// gait (callbacks/gs_balance.h) at every row of FILE: a solution's states.sto with its grf.mot,
+// or a trial's coordinates.mot with its measured grf.mot. Prints each foot's single-stance
+// figures and the stride's ranges (the table of docs/BENCHMARKS.md, "Stance width").
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <mujoco/mujoco.h>
+
+#include "app/gs_app_model.h"
+#include "app/gs_commands.h"
+#include "app/gs_options.h"
+#include "callbacks/gs_balance.h"
+#include "callbacks/gs_state.h"
+
+#define BALANCE_STANCE_N 20.0  // a foot is in stance above this vertical force (N)
+
+static const char* kBalanceUsage =
+    "usage: gaitsim balance MODEL --pose FILE --grf GRF.mot\n\n"
+    "The frontal-plane balance of a gait by inverse dynamics under the given ground reactions,\n"
+    "at every row of FILE (a solution's states.sto, or a trial's coordinates.mot; speeds missing\n"
+    "from FILE and all accelerations by central differences of its rows). GRF.mot: OpenSim\n"
+    "ExternalLoads columns (ground_force_r_vx ... ground_torque_l_z), e.g. the solution's or the\n"
+    "trial's grf.mot. Prints, for each foot's single stance (its vertical force above 20 N, the\n"
+    "other's not): the centre of pressure against the hip centre and the whole-body centre of\n"
+    "mass (cm, + lateral), the hip abductors' net moment (N m), the ground reaction's frontal\n"
+    "moment about the centre of mass; over the stride: the frontal angular momentum about the\n"
+    "centre of mass, lumbar_bending, the trunk's sway about the centre of mass, and the pelvis\n"
+    "residuals (zero for a dynamically consistent motion and load).\n";
+
+// the ground reactions of the table at time, in the model world
+static void loads_at(const gsTable* g, const int* col, double time, gsFootLoad load[2]) {
+  for (int s = 0; s < 2; s++) {
+    double v[9];
+    for (int k = 0; k < 9; k++) v[k] = gs_table_value_at(g, col[9 * s + k], time);
+    gs_balance_from_opensim(v, load[s].force);
+    gs_balance_from_opensim(v + 3, load[s].cop);
+    gs_balance_from_opensim(v + 6, load[s].torque);
+    load[s].loaded = load[s].force[2] > BALANCE_STANCE_N;
+  }
+}
+
+typedef struct stat_ {
+  double sum, sumsq, lo, hi;
+  int n;
+} stat;
+
+static void add(stat* s, double x) {
+  if (!isfinite(x)) return;
+  if (s->n == 0 || x < s->lo) s->lo = x;
+  if (s->n == 0 || x > s->hi) s->hi = x;
+  s->sum += x;
+  s->sumsq += x * x;
+  s->n++;
+}
+static double mean(const stat* s) { return s->n ? s->sum / s->n : NAN; }
+static double rms(const stat* s) { return s->n ? sqrt(s->sumsq / s->n) : NAN; }
+
+int gs_cmd_balance(int argc, char** argv) {
+  static const struct option options[] = {{"pose", required_argument, NULL, 'p'},
+                                          {"grf", required_argument, NULL, 'g'},
+                                          {"help", no_argument, NULL, 'h'},
+                                          {NULL, 0, NULL, 0}};
+  const char *pose = NULL, *grf = NULL;
+  optind = 1;
+  opterr = 0;
+  int c;
+  while ((c = getopt_long(argc, argv, ":p:g:h", options, NULL)) != -1) {
+    switch (c) {
+      case 'p': pose = optarg; break;
+      case 'g': grf = optarg; break;
+      case 'h': fputs(kBalanceUsage, stdout); return GS_EXIT_OK;
+      default: return gs_opt_getopt_error("balance", c, argv);
+    }
+  }
+  if (gs_opt_one_operand("balance", "MODEL", argc, argv) != 0) return GS_EXIT_USAGE;
+  if (!pose) return gs_opt_usage_error("balance", "missing --pose FILE");
+  if (!grf) return gs_opt_usage_error("balance", "missing --grf GRF.mot");
+  const char* path = argv[optind];
+  mjModel* m = gs_app_load_model(path);
+  if (!m) return GS_EXIT_FAILURE;
+  int status = GS_EXIT_FAILURE;
+  mjData* d = mj_makeData(m);
+  gsTable t, g;
+  gs_table_init(&t);
+  gs_table_init(&g);
+  gsStateMap map = {0};
+  gsBalanceSpec spec;
+  char err[512];
+  double *q = NULL, *v = NULL, *a = NULL;
+  if (gs_balance_spec(m, &spec, err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s: %s\n", path, err);
+    goto done;
+  }
+  if (gs_app_read_table(m, pose, &t) != 0 || gs_app_require_coordinates(m, &t, pose) != 0)
+    goto done;
+  if (gs_state_map(m, &t, &map, err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s: %s\n", pose, err);
+    goto done;
+  }
+  if (t.nrow < 3) {
+    fprintf(stderr, "gaitsim: %s: %d rows; the differences need at least 3\n", pose, t.nrow);
+    goto done;
+  }
+  if (gs_app_read_table(m, grf, &g) != 0) goto done;
+  int col[18];
+  for (int k = 0; k < 18; k++) {
+    col[k] = gs_table_column(&g, gs_grf_labels[k]);
+    if (col[k] < 0) {
+      fprintf(stderr, "gaitsim: %s: no column %s (OpenSim ExternalLoads names expected)\n", grf,
+              gs_grf_labels[k]);
+      goto done;
+    }
+  }
+  // qpos and qvel of every row; speeds from the file when it has them all, else differences
+  int n = t.nrow, nq = m->nq, nv = m->nv;
+  q = (double*)malloc(sizeof(double) * (size_t)(n * nq));
+  v = (double*)malloc(sizeof(double) * (size_t)(n * nv));
+  a = (double*)malloc(sizeof(double) * (size_t)(n * nv));
+  if (!q || !v || !a) {
+    fprintf(stderr, "gaitsim: balance: out of memory\n");
+    goto done;
+  }
+  for (int i = 0; i < n; i++) {
+    mj_resetData(m, d);
+    gs_state_apply(m, &t, &map, t.time[i], d);
+    mju_copy(q + i * nq, d->qpos, nq);
+    mju_copy(v + i * nv, d->qvel, nv);
+  }
+  int speeds = map.nv_found == nv;
+  for (int pass = speeds; pass < 2; pass++) {  // 0: velocities from positions, 1: accelerations
+    for (int i = 0; i < n; i++) {
+      int i0 = i > 0 ? i - 1 : 0, i1 = i < n - 1 ? i + 1 : n - 1;
+      double dt = t.time[i1] - t.time[i0];
+      if (pass == 0) {
+        mj_differentiatePos(m, v + i * nv, dt, q + i0 * nq, q + i1 * nq);
+      } else {
+        for (int k = 0; k < nv; k++) a[i * nv + k] = (v[i1 * nv + k] - v[i0 * nv + k]) / dt;
+      }
+    }
+  }
+  stat cop_hip[2] = {0}, cop_com[2] = {0}, abd[2] = {0}, mom[2] = {0}, ang = {0}, bend = {0},
+       sway = {0}, resf = {0}, resm = {0};
+  double weight = mj_getTotalmass(m) * mju_norm3(m->opt.gravity);
+  for (int i = 0; i < n; i++) {
+    mj_resetData(m, d);
+    gs_state_apply(m, &t, &map, t.time[i], d);
+    mju_copy(d->qpos, q + i * nq, nq);
+    mju_copy(d->qvel, v + i * nv, nv);
+    gsFootLoad load[2];
+    loads_at(&g, col, t.time[i], load);
+    gsBalance b;
+    gs_balance_eval(m, d, &spec, a + i * nv, load, &b);
+    for (int s = 0; s < 2; s++) {
+      if (!load[s].loaded || load[1 - s].loaded) continue;  // single stance of foot s
+      add(&cop_hip[s], b.cop_lateral_hip[s]);
+      add(&cop_com[s], b.cop_lateral_com[s]);
+      add(&abd[s], -b.hip_adduction_moment[s]);
+      add(&mom[s], fabs(b.grf_moment[0]));
+    }
+    add(&ang, b.angmom[0]);
+    add(&bend, b.lumbar_bending);
+    add(&sway, b.trunk_lateral);
+    add(&resf, mju_norm3(b.residual_force));
+    add(&resm, mju_norm3(b.residual_moment));
+  }
+  printf("frontal-plane balance of %s with %s (%s, %d rows, %.3f-%.3f s; speeds %s)\n", pose,
+         grf, path, n, t.time[0], t.time[n - 1],
+         speeds ? "from the file" : "by central differences");
+  printf("| single stance | right | left |\n|---|---|---|\n");
+  printf("| rows | %d | %d |\n", cop_hip[0].n, cop_hip[1].n);
+  printf("| centre of pressure minus hip centre, mean (cm, + lateral) | %.1f | %.1f |\n",
+         100 * mean(&cop_hip[0]), 100 * mean(&cop_hip[1]));
+  printf("| centre of pressure minus whole-body CoM, mean (cm, + lateral) | %.1f | %.1f |\n",
+         100 * mean(&cop_com[0]), 100 * mean(&cop_com[1]));
+  printf("| hip abductors' net moment by inverse dynamics, mean / peak (N m) | %.1f / %.1f | "
+         "%.1f / %.1f |\n", mean(&abd[0]), abd[0].hi, mean(&abd[1]), abd[1].hi);
+  printf("| ground reaction's frontal moment about the CoM, peak / RMS (N m) | %.1f / %.1f | "
+         "%.1f / %.1f |\n", mom[0].hi, rms(&mom[0]), mom[1].hi, rms(&mom[1]));
+  printf("frontal angular momentum about the CoM: %.2f ... %.2f N m s\n", ang.lo, ang.hi);
+  printf("lumbar_bending: %.1f ... %.1f deg\n", bend.lo * 180 / M_PI, bend.hi * 180 / M_PI);
+  printf("trunk CoM sway about the whole-body CoM (range): %.1f cm\n", 100 * (sway.hi - sway.lo));
+  printf("pelvis residuals, RMS: force %.1f N (%.3f BW), moment %.1f N m\n", rms(&resf),
+         rms(&resf) / weight, rms(&resm));
+  status = GS_EXIT_OK;
+done:
+  free(q);
+  free(v);
+  free(a);
+  gs_state_map_free(&map);
+  gs_table_free(&t);
+  gs_table_free(&g);
+  mj_deleteData(d);
+  mj_deleteModel(m);
+  return status;
+}

@@ -1,0 +1,88 @@
+// gs_balance.c: frontal-plane balance by inverse dynamics (equations in gs_balance.h).
+#include "callbacks/gs_balance.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "callbacks/gs_model_info.h"
+
+static int find(const mjModel* m, int type, const char* name, int* id, char* err, int errsz) {
+  *id = mj_name2id(m, type, name);
+  if (*id < 0) snprintf(err, (size_t)errsz, "no %s \"%s\" (the balance needs it)",
+                        type == mjOBJ_BODY ? "body" : "joint", name);
+  return *id < 0 ? -1 : 0;
+}
+
+int gs_balance_spec(const mjModel* m, gsBalanceSpec* spec, char* err, int errsz) {
+  if (find(m, mjOBJ_BODY, "pelvis", &spec->root_body, err, errsz) ||
+      find(m, mjOBJ_BODY, "torso", &spec->trunk_body, err, errsz) ||
+      find(m, mjOBJ_JOINT, "hip_adduction", &spec->hip_joint[0], err, errsz) ||
+      find(m, mjOBJ_JOINT, "hip_adduction_l", &spec->hip_joint[1], err, errsz))
+    return -1;
+  spec->lumbar_bending = mj_name2id(m, mjOBJ_JOINT, "lumbar_bending");
+  for (int s = 0; s < 2; s++) {
+    spec->foot_body[s] = -1;
+    for (int g = 0; g < m->ngeom && spec->foot_body[s] < 0; g++)
+      if (gs_geom_contact_side(m, g) == (s == 0 ? 'r' : 'l')) spec->foot_body[s] = m->geom_bodyid[g];
+    if (spec->foot_body[s] < 0) {
+      snprintf(err, (size_t)errsz, "no contact sphere on the %s foot (contact_%c_<k>)",
+               s == 0 ? "right" : "left", s == 0 ? 'r' : 'l');
+      return -1;
+    }
+  }
+  return 0;
+}
+
+void gs_balance_from_opensim(const double os[3], double world[3]) {
+  double x = os[0], y = os[1], z = os[2];
+  world[0] = x;
+  world[1] = -z;
+  world[2] = y;
+}
+
+void gs_balance_eval(const mjModel* m, mjData* d, const gsBalanceSpec* spec, const double* qacc,
+                     const gsFootLoad load[2], gsBalance* out) {
+  mj_forward(m, d);
+  mj_subtreeVel(m, d);
+  const double* com = d->subtree_com + 3 * spec->root_body;
+  mju_copy3(out->com, com);
+  mju_copy3(out->angmom, d->subtree_angmom + 3 * spec->root_body);
+
+  // tau = M qdd + c - sum J^T [F; T]
+  mjMARKSTACK;
+  mjtNum* tau = mj_stackAlloc(d, m->nv);
+  mjtNum* ext = mj_stackAlloc(d, m->nv);
+  mju_copy(d->qacc, qacc, m->nv);
+  mj_mulM(m, d, tau, d->qacc);
+  mju_addTo(tau, d->qfrc_bias, m->nv);
+  mju_zero(ext, m->nv);
+  mju_zero3(out->grf_moment);
+  for (int s = 0; s < 2; s++) {
+    const double* hip = d->xanchor + 3 * spec->hip_joint[s];
+    double side = s == 0 ? -1.0 : 1.0;  // lateral: -y right, +y left
+    out->cop_lateral_hip[s] = out->cop_lateral_com[s] = NAN;
+    if (!load[s].loaded) continue;
+    mj_applyFT(m, d, load[s].force, load[s].torque, load[s].cop, spec->foot_body[s], ext);
+    double r[3], rxf[3];
+    mju_sub3(r, load[s].cop, com);
+    mju_cross(rxf, r, load[s].force);
+    for (int k = 0; k < 3; k++) out->grf_moment[k] += rxf[k] + load[s].torque[k];
+    out->cop_lateral_hip[s] = side * (load[s].cop[1] - hip[1]);
+    out->cop_lateral_com[s] = side * (load[s].cop[1] - com[1]);
+  }
+  mju_subFrom(tau, ext, m->nv);
+  for (int s = 0; s < 2; s++)
+    out->hip_adduction_moment[s] = tau[m->jnt_dofadr[spec->hip_joint[s]]];
+  // the root's six dofs: pelvis_tx, _ty, _tz (slides) then pelvis_rz, _rx, _ry (hinges)
+  int r0 = m->body_dofadr[spec->root_body], six = m->body_dofnum[spec->root_body] == 6;
+  for (int k = 0; k < 3; k++) {
+    out->residual_force[k] = six ? tau[r0 + k] : NAN;
+    out->residual_moment[k] = six ? tau[r0 + 3 + k] : NAN;
+  }
+  mjFREESTACK;
+  out->trunk_lateral = d->subtree_com[3 * spec->trunk_body + 1] - com[1];
+  out->lumbar_bending =
+      spec->lumbar_bending >= 0 ? d->qpos[m->jnt_qposadr[spec->lumbar_bending]] : NAN;
+}

@@ -1,0 +1,50 @@
+#!/usr/bin/env bash
+# gaitsim balance on JW's measured gait (jw_ngait_og5: coordinates.mot, the force plates'
+# grf.mot) with jw_fullbody_knee6: exit 0; in single stance the inverse dynamics' hip abductor
+# moments (46.0 N m right, 58.6 N m left on average) lie within 40-52 and 52-65 N m, each centre
+# of pressure medial of its hip centre (as measured in vivo gait: the foot under the body), the
+# whole-body CoM between the feet; the frontal angular momentum stays within +-4 N m s and the
+# pelvis residuals are reported. Bad input: a missing --grf (exit 2), a ground-reaction file
+# without the ExternalLoads columns and a model without hip_adduction (exit 1), each one line
+# naming the file and the reason.
+# usage: balance.sh GAITSIM SOURCE_DIR
+set -u
+gaitsim=$1 src=$2
+source "$(dirname "$0")/../cli_common.bash"
+
+T=$src/mjmodels/trials/jw_ngait_og5 M=$src/mjmodels/jw_fullbody_knee6.xml
+"$gaitsim" balance "$M" --pose "$T/coordinates.mot" --grf "$T/grf.mot" >out.txt 2>err.txt
+status=$?
+check "measured gait: exit 0 (got $status)" test "$status" -eq 0
+check "measured gait: the figures against their ranges ($(tr '\n' ' ' <out.txt))" /usr/bin/python3 - out.txt <<'PY'
+import re, sys
+rows = {}
+for line in open(sys.argv[1]):
+    cells = [c.strip() for c in line.strip().strip("|").split("|")]
+    if len(cells) == 3:
+        rows[cells[0]] = cells[1:]
+def pair(key, k):
+    return [float(c.split("/")[k]) for c in rows[key]]
+abd = pair("hip abductors' net moment by inverse dynamics, mean / peak (N m)", 0)
+hip = pair("centre of pressure minus hip centre, mean (cm, + lateral)", 0)
+com = pair("centre of pressure minus whole-body CoM, mean (cm, + lateral)", 0)
+txt = open(sys.argv[1]).read()
+lo, hi = map(float, re.search(r"angular momentum about the CoM: (\S+) \.\.\. (\S+) N m s", txt).groups())
+ok = 40 <= abd[0] <= 52 and 52 <= abd[1] <= 65 and all(h < 0 for h in hip) and all(c > 0 for c in com)
+ok &= -4 < lo < 0 < hi < 4 and "pelvis residuals, RMS: force" in txt
+sys.exit(0 if ok else 1)
+PY
+"$gaitsim" balance "$M" --pose "$T/coordinates.mot" >/dev/null 2>err.txt
+status=$?
+check "no --grf: exit 2 (got $status), one line naming it" test "$status" -eq 2 -a "$(wc -l <err.txt)" -eq 1
+check "no --grf: the line" grep -q -- "--grf" err.txt
+"$gaitsim" balance "$M" --pose "$T/coordinates.mot" --grf "$T/coordinates.mot" >/dev/null 2>err.txt
+status=$?
+check "a coordinates file as --grf: exit 1 (got $status)" test "$status" -eq 1
+check "a coordinates file as --grf: one line naming the file and column ($(cat err.txt))" \
+  test "$(wc -l <err.txt)" -eq 1 -a "$(grep -c "coordinates.mot: no column ground_force_r_vx" err.txt)" -eq 1
+"$gaitsim" balance "$src/mjmodels/gait2d.xml" --pose "$T/coordinates.mot" --grf "$T/grf.mot" >/dev/null 2>err.txt
+status=$?
+check "planar model: exit 1 (got $status), one line naming what is missing ($(cat err.txt))" \
+  test "$status" -eq 1 -a "$(wc -l <err.txt)" -eq 1 -a "$(grep -c 'gait2d.xml: no ' err.txt)" -eq 1
+finish

@@ -8,7 +8,6 @@
 #include <stdlib.h>
 #include <string.h>
 #include <errno.h>
-#include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -80,15 +79,7 @@ static int sub(gsCommandFn fn, const char* const* words) {
 static int sub_in_child(gsCommandFn fn, const char* const* words) {
   fflush(stdout);
   fflush(stderr);
-  sigset_t stops, before;
-  sigemptyset(&stops);
-  sigaddset(&stops, SIGINT);
-  sigaddset(&stops, SIGTERM);
-  sigaddset(&stops, SIGHUP);
-  sigprocmask(SIG_BLOCK, &stops, &before);  // held back until the child is registered
-  pid_t pid = fork();
-  if (pid > 0) go_ipopt_forward_signals_to((long)pid, 1);
-  sigprocmask(SIG_SETMASK, &before, NULL);
+  pid_t pid = (pid_t)go_ipopt_fork_forwarded();
   if (pid == 0) {
     int rc = sub(fn, words);
     fflush(stdout);

@@ -11,7 +11,6 @@
 #include <errno.h>
 #include <getopt.h>
 #include <math.h>
-#include <signal.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -160,31 +159,15 @@ static int from_guess(const char* guess, const double* v, int n, int jobs, const
                       const char* nodes, const char* max_time, const char* max_iter) {
   pid_t running[SWEEP_MAX_JOBS] = {0};
   int nrun = 0, next = 0, failed = GS_EXIT_OK, stopped_short = 0;
-  sigset_t stops, before;
-  sigemptyset(&stops);
-  sigaddset(&stops, SIGINT);
-  sigaddset(&stops, SIGTERM);
-  sigaddset(&stops, SIGHUP);
   while (next < n || nrun > 0) {
     if (next < n && nrun < jobs && go_ipopt_stop_signals() == 0) {
       char out[4096];
       snprintf(out, sizeof(out), "%s/predict_%.4g", dir, v[next]);
-      // stop signals held back until the child is registered; the child forgets its siblings
-      // (they have their signal from this process)
-      sigprocmask(SIG_BLOCK, &stops, &before);
       fflush(stdout);
       fflush(stderr);
-      pid_t pid = fork();
-      if (pid == 0) {
-        for (int k = 0; k < nrun; k++) go_ipopt_forward_signals_to((long)running[k], 0);
-        sigprocmask(SIG_SETMASK, &before, NULL);
-        _exit(solve_one(guess, v[next], out, nodes, max_time, max_iter));
-      }
-      if (pid > 0) {
-        go_ipopt_forward_signals_to((long)pid, 1);
-        running[nrun++] = pid;
-      }
-      sigprocmask(SIG_SETMASK, &before, NULL);
+      pid_t pid = (pid_t)go_ipopt_fork_forwarded();
+      if (pid == 0) _exit(solve_one(guess, v[next], out, nodes, max_time, max_iter));
+      if (pid > 0) running[nrun++] = pid;
       if (pid < 0) {
         fprintf(stderr, "gaitsim: sweep: %.4g m/s: fork: %s\n", v[next], strerror(errno));
         if (failed == GS_EXIT_OK) failed = GS_EXIT_FAILURE;
@@ -290,16 +273,8 @@ int gs_cmd_sweep(int argc, char** argv) {
     printf("sweep: %d speeds around the guess's %.3f m/s by continuation: %d downwards, %d "
            "upwards\n", n, v0, nd, nu);
     fflush(stdout);
-    // stop signals reach both chains: held back until the child is registered
-    sigset_t stops, before;
-    sigemptyset(&stops);
-    sigaddset(&stops, SIGINT);
-    sigaddset(&stops, SIGTERM);
-    sigaddset(&stops, SIGHUP);
-    sigprocmask(SIG_BLOCK, &stops, &before);
-    pid_t pid = nd > 0 && nu > 0 ? fork() : -1;
-    if (pid > 0) go_ipopt_forward_signals_to((long)pid, 1);
-    sigprocmask(SIG_SETMASK, &before, NULL);
+    // stop signals reach both chains
+    pid_t pid = nd > 0 && nu > 0 ? (pid_t)go_ipopt_fork_forwarded() : -1;
     if (pid == 0) _exit(chain(guess, v, down, nd, dir, nodes, max_time, max_iter));
     rc_up = chain(guess, v, up, nu, dir, nodes, max_time, max_iter);
     if (pid > 0) {

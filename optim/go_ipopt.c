@@ -93,6 +93,21 @@ static int install_handlers(struct sigaction old[3]) {
   return 0;
 }
 
+long go_ipopt_fork_forwarded(void) {
+  sigset_t stops, before;
+  sigemptyset(&stops);
+  for (int i = 0; i < 3; i++) sigaddset(&stops, kStopSignals[i]);
+  sigprocmask(SIG_BLOCK, &stops, &before);  // held back until the child is registered
+  pid_t pid = fork();
+  if (pid == 0) {
+    for (int i = 0; i < GO_MAX_CHILDREN; i++) children[i] = 0;  // siblings: the parent's
+  } else if (pid > 0) {
+    go_ipopt_forward_signals_to((long)pid, 1);
+  }
+  sigprocmask(SIG_SETMASK, &before, NULL);
+  return (long)pid;
+}
+
 int go_ipopt_install_stop_signals(void (*hard_stop)(void)) {
   hard_stop_fn = hard_stop;
   if (stop_signals_installed) return 0;

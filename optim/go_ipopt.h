@@ -162,6 +162,13 @@ int go_ipopt_stop_signals(void);
 // Register (pid > 0) or drop a child process that stop signals are passed on to (at most 8).
 void go_ipopt_forward_signals_to(long pid, int add);
 
+// fork() a child that stop signals are passed on to: the signals are held back until the child
+// is registered (none is lost between fork and registration), and the child starts with no
+// registered processes (its siblings get their signals from the parent, not from it). Returns
+// fork()'s value; the caller drops the child with go_ipopt_forward_signals_to(pid, 0) once it
+// has been waited for.
+long go_ipopt_fork_forwarded(void);
+
 // The best-iterate ranking (above): 1 when the point (objective f, max scaled violation viol)
 // beats the best one so far (best_f, best_viol), with tol the best_viol_tol of the solve.
 int go_ipopt_point_better(double f, double viol, double best_f, double best_viol, double tol);

@@ -130,24 +130,22 @@ int gs_cmd_balance(int argc, char** argv) {
     mju_copy(q + i * nq, d->qpos, nq);
     mju_copy(v + i * nv, d->qvel, nv);
   }
+  // central differences between the neighbouring rows (one-sided at the ends)
   int speeds = map.nv_found == nv;
-  for (int pass = speeds; pass < 2; pass++) {  // 0: velocities from positions, 1: accelerations
-    for (int i = 0; i < n; i++) {
-      int i0 = i > 0 ? i - 1 : 0, i1 = i < n - 1 ? i + 1 : n - 1;
-      double dt = t.time[i1] - t.time[i0];
-      if (pass == 0) {
-        mj_differentiatePos(m, v + i * nv, dt, q + i0 * nq, q + i1 * nq);
-      } else {
-        for (int k = 0; k < nv; k++) a[i * nv + k] = (v[i1 * nv + k] - v[i0 * nv + k]) / dt;
-      }
-    }
+  for (int i = 0; !speeds && i < n; i++) {
+    int i0 = i > 0 ? i - 1 : 0, i1 = i < n - 1 ? i + 1 : n - 1;
+    mj_differentiatePos(m, v + i * nv, t.time[i1] - t.time[i0], q + i0 * nq, q + i1 * nq);
+  }
+  for (int i = 0; i < n; i++) {
+    int i0 = i > 0 ? i - 1 : 0, i1 = i < n - 1 ? i + 1 : n - 1;
+    for (int k = 0; k < nv; k++)
+      a[i * nv + k] = (v[i1 * nv + k] - v[i0 * nv + k]) / (t.time[i1] - t.time[i0]);
   }
   stat cop_hip[2] = {0}, cop_com[2] = {0}, abd[2] = {0}, mom[2] = {0}, ang = {0}, bend = {0},
        sway = {0}, resf = {0}, resm = {0};
   double weight = mj_getTotalmass(m) * mju_norm3(m->opt.gravity);
   for (int i = 0; i < n; i++) {
-    mj_resetData(m, d);
-    gs_state_apply(m, &t, &map, t.time[i], d);
+    mj_resetData(m, d);  // only the coordinates and speeds matter to the balance
     mju_copy(d->qpos, q + i * nq, nq);
     mju_copy(d->qvel, v + i * nv, nv);
     gsFootLoad load[2];

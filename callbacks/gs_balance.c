@@ -44,7 +44,8 @@ void gs_balance_from_opensim(const double os[3], double world[3]) {
 
 void gs_balance_eval(const mjModel* m, mjData* d, const gsBalanceSpec* spec, const double* qacc,
                      const gsFootLoad load[2], gsBalance* out) {
-  mj_forward(m, d);
+  mj_fwdPosition(m, d);  // kinematics, centres of mass, M (d->qM)
+  mj_fwdVelocity(m, d);  // c (d->qfrc_bias), body velocities
   mj_subtreeVel(m, d);
   const double* com = d->subtree_com + 3 * spec->root_body;
   mju_copy3(out->com, com);

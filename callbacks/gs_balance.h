@@ -61,7 +61,8 @@ typedef struct gsBalance_ {
 int gs_balance_spec(const mjModel* m, gsBalanceSpec* spec, char* err, int errsz);
 
 // The balance at d's qpos, qvel and the accelerations qacc (nv), with the ground reactions
-// load[2] (right, left). Runs mj_forward and mj_subtreeVel on d (d->qacc is overwritten).
+// load[2] (right, left). Runs MuJoCo's position and velocity stages and mj_subtreeVel on d
+// (d->qacc is overwritten).
 void gs_balance_eval(const mjModel* m, mjData* d, const gsBalanceSpec* spec, const double* qacc,
                      const gsFootLoad load[2], gsBalance* out);
 

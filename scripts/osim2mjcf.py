@@ -2250,8 +2250,11 @@ def standing_pose(model, zero, frames, soles):
 
 
 class Converter:
-    def __init__(self, model, metabolic, frames, osim_name, heel_strikes, grf_path, meshes):
+    def __init__(self, model, metabolic, frames, osim_name, heel_strikes, grf_path, meshes,
+                 wrap_fit=None):
         self.model = model
+        # {muscle: fitted wrap geom} of scripts/fit_wraps.py (mjmodels/README.md, "Fitted wraps")
+        self.wrap_fit = wrap_fit or {}
         self.meshes = meshes     # body -> [(mesh, scale, class)] (display_meshes)
         self.metabolic = metabolic
         self.frames = frames
@@ -2312,16 +2315,48 @@ class Converter:
             for wp in mus["wraps"]:
                 if wp["object"] not in [w["name"] for (_, w) in seg_wraps.values()]:
                     self.notes["dropped_wraps"].append((mus["name"], wp["object"]))
+            fit = self.wrap_fit.get(mus["name"])
             for s, (i, p, loc) in enumerate(kept):
                 site = "%s-P%d" % (mus["name"], i + 1)
                 self.sites.setdefault(p["body"], []).append((site, loc))
                 elements.append(("site", site))
                 if s in seg_wraps:
+                    if fit and fit["slot"] == len(elements):
+                        elements.extend(self.fitted_wrap(mus["name"], fit))
+                        continue
                     body, w = seg_wraps[s]
                     geom = self.wrap_geom_name(body, w)
                     side = self.side_site(body, w)
                     elements.append(("geom", geom, side))
+            if fit and not any(e[0] == "geom" and e[1] == mus["name"] + "_wrap"
+                               for e in elements):  # the slot must be one of the path's wraps
+                raise SystemExit("osim2mjcf.py: --wrap-fit: %s's fitted wrap (slot %d) is not a "
+                                 "wrap of its path" % (mus["name"], fit["slot"]))
             self.tendons.append((mus, elements))
+
+    def fitted_wrap(self, muscle, fit):
+        """The muscle's own wrap geoms (with side sites) and the via sites between them, as
+        scripts/fit_wraps.py placed them (names as its part_names: <muscle>_wrap, _wrap2, ...,
+        _wrap_side, <muscle>_via2); returns their tendon elements in path order."""
+        elements = []
+        for k, part in enumerate(fit["parts"]):
+            tag = "" if k == 0 else str(k + 1)
+            if part["kind"] == "via":
+                name = "%s_via%s" % (muscle, tag)
+                self.sites.setdefault(part["body"], []).append((name, part["pos"]))
+                elements.append(("site", name))
+                continue
+            name = "%s_wrap%s" % (muscle, tag)
+            self.wrap_geoms.setdefault(part["body"], []).append({
+                "name": name, "type": part["type"], "radius": part["size"][0],
+                "half": part["size"][1] if part["type"] == "cylinder" else 0.0,
+                "pos": part["pos"], "quat": part["quat"]})
+            side = None
+            if part["side"] is not None:
+                side = name + "_side"
+                self.sites.setdefault(part["body"], []).append((side, part["side"]))
+            elements.append(("geom", name, side))
+        return elements
 
     def wrap_geom_name(self, body, w):
         lst = self.wrap_geoms.setdefault(body, [])
@@ -2413,7 +2448,7 @@ class Converter:
                 "%s %s" % (fmt(spec["radius"]), fmt(max(spec["half"], spec["radius"])))
             out.append('%s<geom name="%s" class="wrap" type="%s" size="%s" pos="%s" quat="%s"/>'
                        % (pad, spec["name"], spec["type"], size, fvec(spec["pos"]),
-                          fvec(quat_from_mat(spec["rot"]))))
+                          fvec(spec["quat"] if "quat" in spec else quat_from_mat(spec["rot"]))))
         for name, pos in self.sites.get(body, []):
             cls = "side" if name.endswith("_side") else "path"
             out.append('%s<site name="%s" class="%s" pos="%s"/>' % (pad, name, cls, fvec(pos)))
@@ -2461,6 +2496,10 @@ class Converter:
         out.append("    GRF of its grf.mot): mjmodels/README.md, Contact spheres and standing pose.")
         out.append("  Display meshes (visual only, no mass, no collision): meshes/, made by")
         out.append("    scripts/make_bone_meshes.py; provenance and licence in meshes/README.md.")
+        if self.wrap_fit:
+            out.append("  Wrap geoms named <muscle>_wrap (%d muscles): fitted to OpenSim's wrapped"
+                       % len(self.wrap_fit))
+            out.append("    paths by scripts/fit_wraps.py (mjmodels/reference/jw_wrap_fit.json).")
         out.append("  Layout of actuator and geom user rows: callbacks/gs_model_layout.h;")
         out.append("    choices and errors: mjmodels/README.md.")
         out.append("-->")
@@ -2660,7 +2699,18 @@ def main():
         os.path.dirname(os.path.abspath(__file__)), "..", "build", "gaitsim"),
         help="the built gaitsim, whose `inspect` measures the model's own path lengths for the "
              "tendon calibration (default: build/gaitsim)")
+    ap.add_argument("--wrap-fit", default=os.path.join(
+        os.path.dirname(os.path.abspath(__file__)), "..", "mjmodels", "reference",
+        "jw_wrap_fit.json"), help="the fitted wrap geoms of scripts/fit_wraps.py ('none': the "
+                                  "converter's own surrogates only)")
     args = ap.parse_args()
+    wrap_fit = {}
+    if args.wrap_fit != "none":
+        try:
+            with open(args.wrap_fit) as f:
+                wrap_fit = json.load(f)["muscles"]
+        except (OSError, ValueError, KeyError) as e:
+            ap.error("--wrap-fit %s: %s" % (args.wrap_fit, e))
     if not os.access(args.gaitsim, os.X_OK):
         ap.error("--gaitsim %s: not an executable (build gaitsim first: README.md)" % args.gaitsim)
     heel_strikes = read_heel_strikes(args.trial_events)
@@ -2675,7 +2725,7 @@ def main():
                                                     "meshes"))
     conv = Converter(model, metabolic, frames, os.path.basename(args.osim), heel_strikes,
                      os.path.join(os.path.dirname(os.path.abspath(args.trial_events)), "grf.mot"),
-                     meshes)
+                     meshes, wrap_fit)
     # the tendon rules on the written model's own path lengths: a draft with the .osim's lts
     # (path lengths do not depend on lts) measured by MuJoCo through gaitsim, next to --out
     draft = os.path.join(os.path.dirname(os.path.abspath(args.out)),

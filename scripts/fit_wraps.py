@@ -1,0 +1,571 @@
+#!/usr/bin/env python3
+"""Fit the MuJoCo wrap surrogates of JW's wrapping muscles to OpenSim's wrapped paths.
+
+MuJoCo 2.2 wraps a spatial tendon over spheres and (infinite) cylinders only, with an optional
+side site; JW's .osim wraps over ellipsoids (SIMM's plane-section method) and cylinders, several
+per segment. The converter's first surrogate (an ellipsoid -> a cylinder of its mean minor radius,
+one wrap per segment) missed OpenSim's paths by up to 27 mm in length and 35 mm in moment arm
+(mjmodels/README.md, "Wrapped reference"). This script gives each wrapping muscle its own wrap
+geom (and side site) and fits their placement, radius and axis so that MuJoCo's path matches
+OpenSim's wrapped path (the converter's port, `wrapped_path`) over the trial:
+
+  minimise  mean e^2 + 10 mean max(0, |e| - 0.5)^2,  e = (L - L_ref) / 5 mm  and
+            (r - r_ref) / max(5 mm, 0.15 |r_ref|) over every fitting pose and primary coordinate
+
+(the tolerance of issue #20 item 1, enforced by tests/test_model_moment_arms.c). Fitting poses:
+every --every-th frame of the trial's IK plus the reference poses of jw_poses.csv. Starts: each
+of the muscle's OpenSim wrap objects as the surrogate (on its own body), without a side site and
+with one at 1.5 radii along each axis perpendicular to the cylinder (each axis of a sphere); each
+start is refined by Nelder-Mead over the geom's position (m), log radius, axis tilt (rad) and the
+side site's position (m), evaluated by MuJoCo itself (build/path_probe, geometry moved in place).
+Muscles whose converter surrogate already meets the tolerance with a margin (max |e| <= --keep)
+keep it. Writes mjmodels/reference/jw_wrap_fit.json, which scripts/osim2mjcf.py reads
+(--wrap-fit); deterministic (fixed starts, no random numbers).
+
+usage (mjmodels/README.md, "Fitted wraps", has the whole regeneration):
+  fit_wraps.py --osim .../JW_AllBody_scaled.osim --model mjmodels/.fit_base.xml --every 20
+         [--probe build/path_probe] [--out mjmodels/reference/jw_wrap_fit.json]
+         [--muscles a,b] [--cache /tmp/wrap_ref.json]
+  fit_wraps.py --osim .../JW_AllBody_scaled.osim --check --every 5    (the written model)
+--model is the converter's model without fitted wraps (osim2mjcf.py --wrap-fit none); with
+--check, the model to measure (default mjmodels/jw_fullbody.xml).
+"""
+import argparse
+import json
+import math
+import os
+import subprocess
+import sys
+import xml.etree.ElementTree as ET
+
+import numpy as np
+from scipy.optimize import minimize
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import osim2mjcf as cv  # noqa: E402
+
+LENGTH_TOL = 0.005      # m: length tolerance (issue #20 item 1)
+ARM_TOL = 0.005         # m: moment-arm tolerance, or ARM_REL of |r_ref| where larger
+ARM_REL = 0.15
+SECONDARY = ("knee_adduction", "knee_rotation", "knee_tx", "knee_ty", "knee_tz")
+SIDE_REACH = 1.5        # side site distance from the axis (radii)
+SIDE_MAX = 0.1          # side sites stay within this distance of their geom's centre (m)
+SIDE_CLEAR = 0.2        # ... and at least this fraction of the radius off its surface
+CLEAR_MIN = 0.002       # path sites next to a wrap geom stay this far outside its surface (m)
+CLEAR_WEIGHT = 1e6      # penalty weight of a smaller clearance (1/m^2)
+STEP_POS = 0.01         # Nelder-Mead initial steps: position (m), log radius, tilt (rad)
+STEP_LOGR = 0.3
+STEP_TILT = 0.3
+MAXFEV = 2500           # evaluations per refinement
+SCREEN_MAXFEV = 600     # evaluations per start
+REFINED = 2             # best starts refined
+TWO_WRAP_ABOVE = 0.9    # max |e| of the best single wrap above which two wraps are tried
+
+
+def quat_mul(a, b):
+    w1, x1, y1, z1 = a
+    w2, x2, y2, z2 = b
+    return [w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+            w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2]
+
+
+def quat_rotvec(v):
+    a = math.sqrt(sum(x * x for x in v))
+    if a < 1e-15:
+        return [1.0, 0.0, 0.0, 0.0]
+    s = math.sin(a / 2) / a
+    return [math.cos(a / 2), v[0] * s, v[1] * s, v[2] * s]
+
+
+def quat_to_mat(q):
+    w, x, y, z = q
+    return [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
+
+
+class Probe:
+    """build/path_probe on one model file: MuJoCo's lengths and moment arms."""
+
+    def __init__(self, exe, model_xml, poses):
+        self.p = subprocess.Popen([exe, model_xml], stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                  text=True, bufsize=1)
+        self.joints = self.p.stdout.readline().split()[1:]
+        if self.p.stdout.readline().strip() != "ready":
+            raise SystemExit("fit_wraps.py: %s did not start on %s" % (exe, model_xml))
+        for pose in poses:
+            self.p.stdin.write("pose " + " ".join(repr(pose[j]) for j in self.joints) + "\n")
+        self.p.stdin.flush()
+
+    def set(self, line):
+        self.p.stdin.write(line + "\n")
+
+    def eval(self, tendon):
+        self.p.stdin.write("eval %s\n" % tendon)
+        self.p.stdin.flush()
+        rows = []
+        while True:
+            line = self.p.stdout.readline()
+            if line.startswith("error"):
+                raise SystemExit("fit_wraps.py: path_probe: " + line.strip())
+            if line.strip() == "end" or not line:
+                break
+            rows.append([float(v) for v in line.split()])
+        return np.array(rows)
+
+    def close(self):
+        self.p.stdin.write("quit\n")
+        self.p.stdin.close()
+        self.p.wait()
+
+
+def reference(model, muscles, poses, methods):
+    """{muscle: {"coords": [...], "L": [pose], "r": [[pose][coord]]}} of OpenSim's wrapped path."""
+    out = {}
+    for mus in muscles:
+        coords = [c for c in cv.crossed_coordinates(model, mus) if c not in SECONDARY]
+        lengths, arms = [], []
+        for pose in poses:
+            lengths.append(cv.wrapped_path(model, mus, pose, methods)[0])
+            r = cv.wrapped_moment_arms(model, mus, pose, coords, methods)
+            arms.append([r[c] for c in coords])
+        out[mus["name"]] = {"coords": coords, "L": lengths, "r": arms}
+        print("reference %-10s %d poses" % (mus["name"], len(poses)), flush=True)
+    return out
+
+
+def errors(ref, joints, rows):
+    """Normalised errors e (length first, then moment arms) over the poses."""
+    cols = [joints.index(c) for c in ref["coords"]]
+    L = rows[:, 0]
+    r = rows[:, [1 + c for c in cols]]
+    rref = np.array(ref["r"])
+    eL = (L - np.array(ref["L"])) / LENGTH_TOL
+    er = (r - rref) / np.maximum(ARM_TOL, ARM_REL * np.abs(rref))
+    return np.concatenate([eL, er.ravel()])
+
+
+def objective_of(e, clearance=None):
+    """mean e^2 + 10 mean max(0, |e| - 0.5)^2, plus CLEAR_WEIGHT max(0, CLEAR_MIN - C)^2 summed
+    over the poses: a site next to a wrap geom on or inside its surface makes MuJoCo's wrap
+    ill-posed (it wraps or not on a rounding of the geometry)."""
+    j = float(np.mean(e * e) + 10.0 * np.mean(np.maximum(0.0, np.abs(e) - 0.5) ** 2))
+    if clearance is not None:
+        j += CLEAR_WEIGHT * float(np.sum(np.maximum(0.0, CLEAR_MIN - clearance) ** 2))
+    return j
+
+
+def body_of(elem_parent, name, tag):
+    for body in elem_parent.iter("body"):
+        for child in body:
+            if child.tag == tag and child.get("name") == name:
+                return body
+    return None
+
+
+def vec(v):
+    return " ".join(repr(float(x)) for x in v)
+
+
+def part_names(muscle, k):
+    """Geom, side-site and via-site names of the k-th part of a muscle's fitted wrap."""
+    tag = "" if k == 0 else str(k + 1)
+    return ("%s_wrap%s" % (muscle, tag), "%s_wrap%s_side" % (muscle, tag),
+            "%s_via%s" % (muscle, tag))
+
+
+def write_variant(base_tree, model_dir, muscle, slot, start):
+    """Model with muscle's wrap element at tendon position `slot` replaced by the parts of
+    `start` (wrap geoms with their side sites, via sites between them); returns the file name
+    (written next to the model, so that its meshes resolve)."""
+    import copy
+    root = copy.deepcopy(base_tree.getroot())
+    bodies = {b.get("name"): b for b in root.iter("body")}
+    tendon = [t for t in root.iter("spatial") if t.get("name") == muscle][0]
+    elems = []
+    for k, part in enumerate(start["parts"]):
+        gname, sname, vname = part_names(muscle, k)
+        body = bodies[part["body"]]
+        if part["kind"] == "via":
+            ET.SubElement(body, "site", {"name": vname, "class": "path", "pos": vec(part["pos"])})
+            elems.append(ET.Element("site", {"site": vname}))
+            continue
+        ET.SubElement(body, "geom", {"name": gname, "class": "wrap", "type": part["type"],
+                                     "size": vec(part["size"]), "pos": vec(part["pos"]),
+                                     "quat": vec(part["quat"])})
+        attrs = {"geom": gname}
+        if part["side"] is not None:
+            ET.SubElement(body, "site", {"name": sname, "class": "side", "pos": vec(part["side"])})
+            attrs["sidesite"] = sname
+        elems.append(ET.Element("geom", attrs))
+    children = list(tendon)
+    for c in children:
+        tendon.remove(c)
+    for c in children[:slot] + elems + children[slot + 1:]:
+        tendon.append(c)
+    path = os.path.join(model_dir, ".fit_wraps.%s.xml" % muscle)
+    ET.ElementTree(root).write(path, encoding="utf-8", xml_declaration=True)
+    return path
+
+
+def part_nparams(part):
+    if part["kind"] == "via":
+        return 3
+    return (6 if part["type"] == "cylinder" else 4) + (3 if part["side"] is not None else 0)
+
+
+def nparams(start):
+    return sum(part_nparams(p) for p in start["parts"])
+
+
+def steps(start):
+    s = []
+    for part in start["parts"]:
+        if part["kind"] == "via":
+            s += [STEP_POS] * 3
+            continue
+        s += [STEP_POS] * 3 + [STEP_LOGR]
+        if part["type"] == "cylinder":
+            s += [STEP_TILT, STEP_TILT]
+        if part["side"] is not None:
+            s += [STEP_POS] * 3
+    return s
+
+
+def written(v):
+    """v as the converter writes it (osim2mjcf.fmt: 8 significant digits), so that the fit
+    evaluates exactly the model that is written."""
+    return [float(cv.fmt(float(u))) for u in v]
+
+
+def geometry(start, x):
+    """The parts of `start` moved by parameter vector x: via sites by dx (m); geoms by dx (m),
+    their radius by a factor exp(x) and a cylinder's axis tilted by a rotation vector
+    perpendicular to it (rad); side sites by dx (m)."""
+    out, k = [], 0
+    for part in start["parts"]:
+        q = dict(part)
+        if part["kind"] == "via":
+            q["pos"] = [part["pos"][i] + x[k + i] for i in range(3)]
+            k += 3
+            out.append(q)
+            continue
+        q["pos"] = [part["pos"][i] + x[k + i] for i in range(3)]
+        q["logr"] = x[k + 3]
+        r = part["size"][0] * math.exp(x[k + 3])
+        k += 4
+        if part["type"] == "cylinder":
+            q["quat"] = quat_mul(part["quat"], quat_rotvec([x[k], x[k + 1], 0.0]))
+            k += 2
+            q["size"] = [r, max(part["size"][1], r)]
+        else:
+            q["size"] = [r]
+        if part["side"] is not None:
+            q["side"] = [part["side"][i] + x[k + i] for i in range(3)]
+            k += 3
+        out.append(q)
+    for q in out:
+        for key in ("pos", "quat", "size", "side"):
+            if q.get(key) is not None:
+                q[key] = written(q[key])
+    return out
+
+
+def feasible(parts):
+    """Radius within a factor 4.5 of the start; side sites within SIDE_MAX of the geom centre."""
+    for q in parts:
+        if q["kind"] == "via":
+            continue
+        if abs(q["logr"]) > 1.5:
+            return False
+        if q["side"] is not None:
+            if math.dist(q["side"], q["pos"]) > SIDE_MAX:
+                return False
+            # MuJoCo wraps differently with the side site inside the surface (always, over the
+            # inside) than outside (on its side, only if the line crosses): keep it clear of
+            # the surface so that the choice does not hang on a rounding
+            rel = [q["side"][i] - q["pos"][i] for i in range(3)]
+            m = quat_to_mat(q["quat"])
+            local = [sum(m[i][k] * rel[i] for i in range(3)) for k in range(3)]
+            dist = math.hypot(local[0], local[1]) if q["type"] == "cylinder" else \
+                math.sqrt(sum(v * v for v in local))
+            if abs(dist - q["size"][0]) < SIDE_CLEAR * q["size"][0]:
+                return False
+    return True
+
+
+def fit_start(probe, muscle, ref, start, x0=None, maxfev=MAXFEV, restarts=3):
+    def run(x):
+        for k, q in enumerate(geometry(start, x)):
+            gname, sname, vname = part_names(muscle, k)
+            if q["kind"] == "via":
+                probe.set("site %s %s" % (vname, vec(q["pos"])))
+                continue
+            size = q["size"] + [0.0] if q["type"] == "sphere" else q["size"]
+            probe.set("geom %s %s %s %s" % (gname, vec(q["pos"]), vec(q["quat"]), vec(size)))
+            if q["side"] is not None:
+                probe.set("site %s %s" % (sname, vec(q["side"])))
+        rows = probe.eval(muscle)
+        return errors(ref, probe.joints, rows), rows[:, -1]
+
+    def f(x):
+        if not feasible(geometry(start, x)):
+            return 1e6
+        return objective_of(*run(x))
+
+    n = nparams(start)
+    x0 = np.zeros(n) if x0 is None else np.array(x0)
+    simplex = [x0] + [x0 + np.eye(n)[i] * steps(start)[i] for i in range(n)]
+    best = None
+    for _ in range(restarts):  # restarts of the simplex at the best point
+        res = minimize(f, x0, method="Nelder-Mead",
+                       options={"initial_simplex": np.array(simplex), "maxfev": maxfev,
+                                "xatol": 1e-6, "fatol": 1e-9, "adaptive": True})
+        if best is None or res.fun < best.fun - 1e-9:
+            best = res
+            x0 = res.x
+            simplex = [x0] + [x0 + np.eye(n)[i] * steps(start)[i] * 0.3 for i in range(n)]
+        else:
+            break
+    e, clearance = run(best.x)
+    print("    least clearance %.1f mm" % (1000 * float(np.min(clearance))))
+    labels = ["L@%d" % k for k in range(len(ref["L"]))] + [
+        "%s@%d" % (c, k) for k in range(len(ref["L"])) for c in ref["coords"]]
+    worst = np.argsort(-np.abs(e))[:4]
+    print("    worst: " + ", ".join("%s %+.2f" % (labels[i], e[i]) for i in worst))
+    parts = []
+    for q in geometry(start, best.x):
+        q = {k: v for k, v in q.items() if k != "logr"}
+        parts.append(q)
+    return best.fun, float(np.max(np.abs(e))), best.x, {"parts": parts, "from": start["from"]}
+
+
+def starts_for(model, mus, base_root, tendon_geom):
+    """Surrogates of each OpenSim wrap object of the muscle, with each side-site choice."""
+    objects = {}
+    for b in model.body_order:
+        for w in model.bodies[b]["wraps"]:
+            objects[w["name"]] = (b, w)
+    out = []
+    names = [pw["object"] for pw in mus["wraps"]]
+    if tendon_geom not in names:
+        names.append(tendon_geom)
+    for name in names:
+        body, w = objects[name]
+        spec = cv.wrap_geom_spec(body, w)
+        mbody = {"patella": "tibial_tray", "patella_l": "tibia_l"}.get(body, body)
+        if mbody != body:
+            continue  # relocated bodies: their frames differ; the converter's own geom covers it
+        shapes = [(spec["type"], spec["radius"], spec["half"], spec["rot"])]
+        if w["type"] == "WrapEllipsoid" and spec["type"] == "cylinder":
+            shapes.append(("sphere", sum(w["dimensions"]) / 3.0, 0.0, w["rotation"]))
+        for kind, radius, half, rot in shapes:
+            quat = cv.quat_from_mat(rot)
+            axes = [0, 1] if kind == "cylinder" else [0, 1, 2]
+            for scale in (1.0, 2.0):
+                r = radius * scale
+                size = [r] if kind == "sphere" else [r, max(half, r)]
+                # no side site (shorter side), one inside (always wraps), one outside per axis
+                sides = [None, list(w["translation"])]
+                for a in axes:
+                    for sgn in (1.0, -1.0):
+                        d = [sgn * rot[i][a] * SIDE_REACH * r for i in range(3)]
+                        sides.append([w["translation"][i] + d[i] for i in range(3)])
+                for side in sides:
+                    out.append({"parts": [{
+                        "kind": "geom", "body": body, "type": kind, "pos": list(w["translation"]),
+                        "quat": quat, "size": size, "side": side}],
+                        "from": "%s %s x%g" % (name, kind, scale)})
+    return out
+
+
+def two_wrap_starts(model, mus, first_site, single):
+    """Two wraps in sequence on one segment, which MuJoCo expresses only with a via site between
+    them: the best single fit `single` (from one OpenSim object) and a surrogate of the muscle's
+    other wrap object, in path order (the object nearer the segment's first site first), with a
+    via site starting at the midpoint of the two centres (in the second object's body)."""
+    objects = {}
+    for b in model.body_order:
+        for w in model.bodies[b]["wraps"]:
+            objects[w["name"]] = (b, w)
+    zero = {c: model.default_value(c) if c in cv.KNEE_SECONDARY else 0.0
+            for c in cv.MODEL_COORDINATES}
+    x0 = model.body_transforms(model.coordinate_values(zero))
+    a = single["parts"][0]
+    a_name = single["from"].split()[0]
+    out = []
+    others = [(pw["object"], 0.0) for pw in mus["wraps"] if pw["object"] != a_name]
+    if not others:  # one long object: a second copy half-way along its axis either side
+        others = [(a_name, 0.5), (a_name, -0.5)]
+    for obj, shift in others:
+        body, w = objects[obj]
+        if body in ("patella", "patella_l"):
+            continue
+        spec = cv.wrap_geom_spec(body, w)
+        centre = [w["translation"][i] + shift * spec["half"] * spec["rot"][i][2]
+                  for i in range(3)]
+        ca = cv.tf_point(x0[a["body"]], a["pos"])
+        cb = cv.tf_point(x0[body], centre)
+        site = cv.tf_point(x0[first_site[0]], first_site[1])
+        mid = [(ca[i] + cb[i]) / 2.0 for i in range(3)]
+        via = {"kind": "via", "body": body,
+               "pos": cv.tf_point(cv.tf_inv(x0[body]), mid)}
+        r = spec["radius"]
+        size = [r] if spec["type"] == "sphere" else [r, max(spec["half"], r)]
+        for side in (None, centre):
+            b_part = {"kind": "geom", "body": body, "type": spec["type"],
+                      "pos": centre, "quat": cv.quat_from_mat(spec["rot"]),
+                      "size": size, "side": side}
+            parts = [dict(a), via, b_part] if math.dist(site, ca) <= math.dist(site, cb) \
+                else [b_part, via, dict(a)]
+            out.append({"parts": parts, "from": "%s + %s%s" % (
+                single["from"], obj, " %+g half" % shift if shift else "")})
+    return out
+
+
+def fit_starts(args, base, model_dir, poses, name, slot, r, starts):
+    """Screen every start briefly, refine the REFINED best; returns (objective, max |e|, fit)."""
+    screened = []
+    for start in starts:
+        path = write_variant(base, model_dir, name, slot, start)
+        try:
+            probe = Probe(args.probe, path, poses)
+            obj, emax, x, fit = fit_start(probe, name, r, start, maxfev=SCREEN_MAXFEV, restarts=1)
+            probe.close()
+        finally:
+            os.unlink(path)
+        print("  from %-44s objective %.4f max |e| %.2f" % (describe(start), obj, emax),
+              flush=True)
+        screened.append((obj, emax, len(screened), start, x))
+    best = None
+    for obj, emax, _, start, x in sorted(screened, key=lambda t: (t[0], t[2]))[:REFINED]:
+        path = write_variant(base, model_dir, name, slot, start)
+        try:
+            probe = Probe(args.probe, path, poses)
+            obj, emax, x, fit = fit_start(probe, name, r, start, x0=x)
+            probe.close()
+        finally:
+            os.unlink(path)
+        print("  refined %-41s objective %.4f max |e| %.2f" % (describe(start), obj, emax),
+              flush=True)
+        if best is None or (emax, obj) < (best[1], best[0]):
+            best = (obj, emax, fit)
+    return best
+
+
+def describe(start):
+    sides = ",".join("-" if p["kind"] == "via" else ("side" if p["side"] is not None else "none")
+                     for p in start["parts"])
+    return "%s [%s]" % (start["from"], sides)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--osim", required=True)
+    ap.add_argument("--model", default="mjmodels/jw_fullbody.xml")
+    ap.add_argument("--probe", default="build/path_probe")
+    ap.add_argument("--out", default="mjmodels/reference/jw_wrap_fit.json")
+    ap.add_argument("--trial-ik", default=None)
+    ap.add_argument("--every", type=int, default=20)
+    ap.add_argument("--muscles", default=None)
+    ap.add_argument("--keep", type=float, default=0.8,
+                    help="keep the converter's surrogate where max |e| is at most this")
+    ap.add_argument("--cache", default=None, help="reference cache (json) to reuse")
+    ap.add_argument("--check", action="store_true",
+                    help="fit nothing: print each wrapping muscle's max |e| of --model over the "
+                         "poses; exit 1 if any is above 1")
+    args = ap.parse_args()
+    if not os.access(args.probe, os.X_OK):
+        ap.error("--probe %s: not an executable (cmake --build build --target path_probe)"
+                 % args.probe)
+    trial = args.trial_ik or os.path.join(os.path.dirname(os.path.abspath(args.osim)), "..",
+                                          "ngait_og5", "IK_ngait_og5.csv")
+    model = cv.OsimModel(args.osim)
+    frames = cv.read_trial(trial)
+    methods = cv.read_wrap_methods(args.osim)
+    idx = sorted(set(range(0, len(frames), args.every)) | set(cv.reference_poses(frames)))
+    poses = [frames[i][1] for i in idx]
+    muscles = [m for m in model.muscles if m["wraps"]]
+    if args.muscles:
+        want = args.muscles.split(",")
+        muscles = [m for m in muscles if m["name"] in want]
+    ref = None
+    if args.cache and os.path.exists(args.cache):
+        with open(args.cache) as f:
+            ref = json.load(f)
+        if ref.get("poses") != idx or any(m["name"] not in ref["muscles"] for m in muscles):
+            ref = None
+    if ref is None:
+        ref = {"poses": idx, "muscles": reference(model, muscles, poses, methods)}
+        if args.cache:
+            with open(args.cache, "w") as f:
+                json.dump(ref, f)
+    base = ET.parse(args.model)
+    model_dir = os.path.dirname(os.path.abspath(args.model))
+    results = {}
+    base_probe = Probe(args.probe, args.model, poses)
+    worst = 0.0
+    for mus in muscles:
+        name = mus["name"]
+        r = ref["muscles"][name]
+        rows0 = base_probe.eval(name)
+        e0 = errors(r, base_probe.joints, rows0)
+        if args.check and np.min(rows0[:, -1]) < CLEAR_MIN:
+            print("%-10s a path site %.1f mm from a wrap surface (at least %.0f mm wanted)" % (
+                name, 1000 * float(np.min(rows0[:, -1])), 1000 * CLEAR_MIN))
+            worst = max(worst, 1e3)
+        tendon = [t for t in base.getroot().iter("spatial") if t.get("name") == name][0]
+        slots = [k for k, el in enumerate(tendon) if el.get("geom")]
+        print("%-10s %s: max |e| %.2f (objective %.3f), %d wrap geom(s)" % (
+            name, "model" if args.check else "converter surrogate", np.max(np.abs(e0)),
+            objective_of(e0), len(slots)), flush=True)
+        if args.check:
+            worst = max(worst, float(np.max(np.abs(e0))))
+            continue
+        if np.max(np.abs(e0)) <= args.keep or len(slots) != 1:
+            continue
+        slot = slots[0]
+        best = fit_starts(args, base, model_dir, poses, name, slot, r,
+                          starts_for(model, mus, base.getroot(), tendon[slot].get("geom")))
+        if best is not None and best[1] > TWO_WRAP_ABOVE:
+            prev = tendon[slot - 1].get("site")
+            site = [el for el in base.getroot().iter("site") if el.get("name") == prev][0]
+            parent = {c: pb for pb in base.getroot().iter("body") for c in pb}[site]
+            first_site = (parent.get("name"), [float(v) for v in site.get("pos").split()])
+            two = fit_starts(args, base, model_dir, poses, name, slot, r,
+                             two_wrap_starts(model, mus, first_site, best[2]))
+            if two is not None and (two[1], two[0]) < (best[1], best[0]):
+                best = two
+        if best is not None and best[1] < np.max(np.abs(e0)):
+            geom = best[2]
+            geom["slot"] = slot
+            geom["max_error"] = best[1]
+            geom["converter_max_error"] = float(np.max(np.abs(e0)))
+            results[name] = geom
+            print("  -> %s: max |e| %.2f (converter %.2f)" % (name, best[1], np.max(np.abs(e0))))
+            write_out(args, idx, trial, results)
+    base_probe.close()
+    if args.check:
+        print("%s: largest max |e| %.2f over %d muscles and %d poses (1 = the tolerance)" % (
+            args.model, worst, len(muscles), len(idx)))
+        sys.exit(1 if worst > 1.0 else 0)
+    write_out(args, idx, trial, results)
+
+
+def write_out(args, idx, trial, results):
+    doc = {"generated_by": "scripts/fit_wraps.py (--every %d, --keep %g)" % (args.every, args.keep),
+           "source": "OpenSim wrapped paths of %s (scripts/osim2mjcf.py wrapped_path) at %d "
+                     "frames of %s" % (os.path.basename(args.osim), len(idx),
+                                       os.path.basename(trial)),
+           "tolerance": "length %g m; moment arm %g m or %g of |r_ref|" % (
+               LENGTH_TOL, ARM_TOL, ARM_REL),
+           "frames": "body frames of the .osim (= the MJCF's bodies); quat w x y z",
+           "muscles": results}
+    with open(args.out, "w") as f:
+        json.dump(doc, f, indent=1, sort_keys=True)
+        f.write("\n")
+    print("wrote %s (%d muscles)" % (args.out, len(results)))
+
+
+if __name__ == "__main__":
+    main()

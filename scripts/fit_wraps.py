@@ -50,7 +50,7 @@ ARM_REL = 0.15
 SECONDARY = ("knee_adduction", "knee_rotation", "knee_tx", "knee_ty", "knee_tz")
 SIDE_REACH = 1.5        # side site distance from the axis (radii)
 SIDE_MAX = 0.1          # side sites stay within this distance of their geom's centre (m)
-SIDE_CLEAR = 0.2        # ... and at least this fraction of the radius off its surface
+SIDE_CLEAR = 0.2        # ... and outside its surface by at least this fraction of the radius
 CLEAR_MIN = 0.002       # path sites next to a wrap geom stay this far outside its surface (m)
 CLEAR_WEIGHT = 1e6      # penalty weight of a smaller clearance (1/m^2)
 STEP_POS = 0.01         # Nelder-Mead initial steps: position (m), log radius, tilt (rad)
@@ -281,15 +281,16 @@ def feasible(parts):
         if q["side"] is not None:
             if math.dist(q["side"], q["pos"]) > SIDE_MAX:
                 return False
-            # MuJoCo wraps differently with the side site inside the surface (always, over the
-            # inside) than outside (on its side, only if the line crosses): keep it clear of
-            # the surface so that the choice does not hang on a rounding
+            # outside the surface, clear of it: with the side site inside, MuJoCo 2.2 wraps by
+            # its inside-wrap iteration, which returned NaN lengths at isolated poses (grac's
+            # first fit, at a 1.2 m/s prediction's iterate), and at the surface the choice
+            # between the two hangs on a rounding
             rel = [q["side"][i] - q["pos"][i] for i in range(3)]
             m = quat_to_mat(q["quat"])
             local = [sum(m[i][k] * rel[i] for i in range(3)) for k in range(3)]
             dist = math.hypot(local[0], local[1]) if q["type"] == "cylinder" else \
                 math.sqrt(sum(v * v for v in local))
-            if abs(dist - q["size"][0]) < SIDE_CLEAR * q["size"][0]:
+            if dist < (1.0 + SIDE_CLEAR) * q["size"][0]:
                 return False
     return True
 
@@ -365,8 +366,8 @@ def starts_for(model, mus, base_root, tendon_geom):
             for scale in (1.0, 2.0):
                 r = radius * scale
                 size = [r] if kind == "sphere" else [r, max(half, r)]
-                # no side site (shorter side), one inside (always wraps), one outside per axis
-                sides = [None, list(w["translation"])]
+                # no side site (shorter side) or one outside along each axis
+                sides = [None]
                 for a in axes:
                     for sgn in (1.0, -1.0):
                         d = [sgn * rot[i][a] * SIDE_REACH * r for i in range(3)]
@@ -412,7 +413,7 @@ def two_wrap_starts(model, mus, first_site, single):
                "pos": cv.tf_point(cv.tf_inv(x0[body]), mid)}
         r = spec["radius"]
         size = [r] if spec["type"] == "sphere" else [r, max(spec["half"], r)]
-        for side in (None, centre):
+        for side in (None,):
             b_part = {"kind": "geom", "body": body, "type": spec["type"],
                       "pos": centre, "quat": cv.quat_from_mat(spec["rot"]),
                       "size": size, "side": side}

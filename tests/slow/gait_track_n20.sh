@@ -17,7 +17,7 @@
 #     each [0.02, 0.04, 0.02], other joints <= 6 deg [1.98]; the right knee contact force,
 #     measured in vivo and not tracked: RMS <= 0.45 BW [0.32] and its peak 1.5-4 BW (the eTibia's
 #     2.4 BW). The knee bound was 0.4 until the gastrocnemii got OpenSim's wrapped paths
-#     (mjmodels/README.md, "Fitted wraps"): 20-node RMS 0.330 -> 0.415 BW, the lateral
+#     (mjmodels/README.md, "Fitted wraps"): 20-node RMS 0.330 -> 0.420 BW, the lateral
 #     compartment's push-off load (issue #20 item 3).
 # About 50 s on 2 cores.
 # usage: gait_track_n20.sh GAITSIM SOURCE_DIR

@@ -220,7 +220,7 @@ def main(argv):
               f"{results}/track and the predictions at 0.8 and 2.0 m/s)"
               + ("" if set(speeds) <= {"0.8", "2"} else
                  f", with the other speeds ({', '.join(s for s in speeds if s not in ('0.8', '2'))}"
-                 f" m/s) by `build/gaitsim predict --guess {results}/track --speed V --out "
+                 f" m/s) by `build/gaitsim predict --guess {results}/track --speed V --threads 1 --out "
                  f"{results}/sweep/predict_V` (each bitwise the speed of `gaitsim sweep`)")
               + ". Regenerate them to check.\n")
         tracking(os.path.join(results, "track"))

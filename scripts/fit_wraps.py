@@ -160,13 +160,6 @@ def vec(v):
     return " ".join(repr(float(x)) for x in v)
 
 
-def part_names(muscle, k):
-    """Geom, side-site and via-site names of the k-th part of a muscle's fitted wrap."""
-    tag = "" if k == 0 else str(k + 1)
-    return ("%s_wrap%s" % (muscle, tag), "%s_wrap%s_side" % (muscle, tag),
-            "%s_via%s" % (muscle, tag))
-
-
 def write_variant(base_tree, model_dir, muscle, slot, start):
     """Model with muscle's wrap element at tendon position `slot` replaced by the parts of
     `start` (wrap geoms with their side sites, via sites between them); returns the file name
@@ -176,7 +169,7 @@ def write_variant(base_tree, model_dir, muscle, slot, start):
     tendon = [t for t in root.iter("spatial") if t.get("name") == muscle][0]
     elems = []
     for k, part in enumerate(start["parts"]):
-        gname, sname, vname = part_names(muscle, k)
+        gname, sname, vname = cv.fitted_part_names(muscle, k)
         body = bodies[part["body"]]
         if part["kind"] == "via":
             ET.SubElement(body, "site", {"name": vname, "class": "path", "pos": vec(part["pos"])})
@@ -290,7 +283,7 @@ def feasible(parts):
 def fit_start(probe, muscle, ref, start, x0=None, maxfev=MAXFEV, restarts=3):
     def run(x):
         for k, q in enumerate(geometry(start, x)):
-            gname, sname, vname = part_names(muscle, k)
+            gname, sname, vname = cv.fitted_part_names(muscle, k)
             if q["kind"] == "via":
                 probe.set("site %s %s" % (vname, vec(q["pos"])))
                 continue
@@ -335,20 +328,16 @@ def fit_start(probe, muscle, ref, start, x0=None, maxfev=MAXFEV, restarts=3):
 
 def starts_for(model, mus, tendon_geom):
     """Surrogates of each OpenSim wrap object of the muscle, with each side-site choice."""
-    objects = {}
-    for b in model.body_order:
-        for w in model.bodies[b]["wraps"]:
-            objects[w["name"]] = (b, w)
+    objects = cv.wrap_objects(model)
     out = []
     names = [pw["object"] for pw in mus["wraps"]]
     if tendon_geom not in names:
         names.append(tendon_geom)
     for name in names:
         body, w = objects[name]
+        if cv.relocated_body(body):
+            continue  # their MJCF frames differ from the .osim's; the converter's geom stays
         spec = cv.wrap_geom_spec(body, w)
-        mbody = {"patella": "tibial_tray", "patella_l": "tibia_l"}.get(body, body)
-        if mbody != body:
-            continue  # relocated bodies: their frames differ; the converter's own geom covers it
         shapes = [(spec["type"], spec["radius"], spec["half"], spec["rot"])]
         if w["type"] == "WrapEllipsoid" and spec["type"] == "cylinder":
             shapes.append(("sphere", sum(w["dimensions"]) / 3.0, 0.0, w["rotation"]))
@@ -377,10 +366,7 @@ def two_wrap_starts(model, mus, first_site, single):
     them: the best single fit `single` (from one OpenSim object) and a surrogate of the muscle's
     other wrap object, in path order (the object nearer the segment's first site first), with a
     via site starting at the midpoint of the two centres (in the second object's body)."""
-    objects = {}
-    for b in model.body_order:
-        for w in model.bodies[b]["wraps"]:
-            objects[w["name"]] = (b, w)
+    objects = cv.wrap_objects(model)
     zero = {c: model.default_value(c) if c in cv.KNEE_SECONDARY else 0.0
             for c in cv.MODEL_COORDINATES}
     x0 = model.body_transforms(model.coordinate_values(zero))
@@ -392,7 +378,7 @@ def two_wrap_starts(model, mus, first_site, single):
         others = [(a_name, 0.5), (a_name, -0.5)]
     for obj, shift in others:
         body, w = objects[obj]
-        if body in ("patella", "patella_l"):
+        if cv.relocated_body(body):
             continue
         spec = cv.wrap_geom_spec(body, w)
         centre = [w["translation"][i] + shift * spec["half"] * spec["rot"][i][2]
@@ -405,40 +391,41 @@ def two_wrap_starts(model, mus, first_site, single):
                "pos": cv.tf_point(cv.tf_inv(x0[body]), mid)}
         r = spec["radius"]
         size = [r] if spec["type"] == "sphere" else [r, max(spec["half"], r)]
-        for side in (None,):
-            b_part = {"kind": "geom", "body": body, "type": spec["type"],
-                      "pos": centre, "quat": cv.quat_from_mat(spec["rot"]),
-                      "size": size, "side": side}
-            parts = [dict(a), via, b_part] if math.dist(site, ca) <= math.dist(site, cb) \
-                else [b_part, via, dict(a)]
-            out.append({"parts": parts, "from": "%s + %s%s" % (
-                single["from"], obj, " %+g half" % shift if shift else "")})
+        b_part = {"kind": "geom", "body": body, "type": spec["type"], "pos": centre,
+                  "quat": cv.quat_from_mat(spec["rot"]), "size": size, "side": None}
+        parts = [dict(a), via, b_part] if math.dist(site, ca) <= math.dist(site, cb) \
+            else [b_part, via, dict(a)]
+        out.append({"parts": parts, "from": "%s + %s%s" % (
+            single["from"], obj, " %+g half" % shift if shift else "")})
     return out
+
+
+def fit_variant(args, base, model_dir, poses, name, slot, r, start, **options):
+    """fit_start on the model with `start` in place of the muscle's wrap (written, probed,
+    removed); returns fit_start's (objective, max |e|, x, fit)."""
+    path = write_variant(base, model_dir, name, slot, start)
+    try:
+        probe = Probe(args.probe, path, poses)
+        result = fit_start(probe, name, r, start, **options)
+        probe.close()
+    finally:
+        os.unlink(path)
+    return result
 
 
 def fit_starts(args, base, model_dir, poses, name, slot, r, starts):
     """Screen every start briefly, refine the REFINED best; returns (objective, max |e|, fit)."""
     screened = []
     for start in starts:
-        path = write_variant(base, model_dir, name, slot, start)
-        try:
-            probe = Probe(args.probe, path, poses)
-            obj, emax, x, fit = fit_start(probe, name, r, start, maxfev=SCREEN_MAXFEV, restarts=1)
-            probe.close()
-        finally:
-            os.unlink(path)
+        obj, emax, x, fit = fit_variant(args, base, model_dir, poses, name, slot, r, start,
+                                        maxfev=SCREEN_MAXFEV, restarts=1)
         print("  from %-44s objective %.4f max |e| %.2f" % (describe(start), obj, emax),
               flush=True)
         screened.append((obj, emax, len(screened), start, x))
     best = None
     for obj, emax, _, start, x in sorted(screened, key=lambda t: (t[0], t[2]))[:REFINED]:
-        path = write_variant(base, model_dir, name, slot, start)
-        try:
-            probe = Probe(args.probe, path, poses)
-            obj, emax, x, fit = fit_start(probe, name, r, start, x0=x)
-            probe.close()
-        finally:
-            os.unlink(path)
+        obj, emax, x, fit = fit_variant(args, base, model_dir, poses, name, slot, r, start,
+                                        x0=x)
         print("  refined %-41s objective %.4f max |e| %.2f" % (describe(start), obj, emax),
               flush=True)
         if best is None or (emax, obj) < (best[1], best[0]):

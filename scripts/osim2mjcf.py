@@ -587,6 +587,28 @@ class OsimModel:
 # muscle paths without wrapping (reference geometry)
 # ------------------------------------------------------------------------------------------------
 
+def wrap_objects(model):
+    """{wrap object name: (body, wrap object)} over every body of the model."""
+    return {w["name"]: (b, w) for b in model.body_order for w in model.bodies[b]["wraps"]}
+
+
+def relocated_body(body):
+    """Patella bodies follow the knee through coupler constraints that make them rigid with the
+    tibia (patfem_flexion = knee_flexion + 1.57 about the same femoral axis, other patfem
+    coordinates locked): they become jointless children of the tibia-side body, returned here
+    (None for every other body, whose MJCF frame is the .osim's)."""
+    return {"patella": "tibial_tray", "patella_l": "tibia_l"}.get(body)
+
+
+def fitted_part_names(muscle, k):
+    """Geom, side-site and via-site names of the k-th part of a muscle's fitted wrap
+    (scripts/fit_wraps.py): <muscle>_wrap, _wrap_side, <muscle>_via for the first part, then
+    with the part's number (_wrap3, _via2, ...)."""
+    tag = "" if k == 0 else str(k + 1)
+    return ("%s_wrap%s" % (muscle, tag), "%s_wrap%s_side" % (muscle, tag),
+            "%s_via%s" % (muscle, tag))
+
+
 def point_is_active(pt, values):
     """ConditionalPathPoint: active while range[0] <= q <= range[1] (OpenSim ConditionalPathPoint)."""
     if pt["type"] != "ConditionalPathPoint":
@@ -620,10 +642,7 @@ def wrap_clearance(model, muscle, independent):
     if not muscle["wraps"]:
         return None
     values, x = model.pose_state(independent)
-    objects = {}
-    for b in model.body_order:
-        for w in model.bodies[b]["wraps"]:
-            objects[w["name"]] = (b, w)
+    objects = wrap_objects(model)
     pts = [(i, tf_point(x[p["body"]], point_location(p, values)))
            for i, p in enumerate(muscle["points"]) if point_is_active(p, values)]
     best = float("inf")
@@ -1284,10 +1303,7 @@ def wrapped_path(model, muscle, independent, methods):
     """OpenSim's wrapped path of a muscle at a pose (GeometryPath::applyWrapObjects with the
     wrap objects above). Returns (length, [names of the wrap objects the path touches])."""
     values, x = model.pose_state(independent)
-    objects = {}
-    for b in model.body_order:
-        for w in model.bodies[b]["wraps"]:
-            objects[w["name"]] = (b, w)
+    objects = wrap_objects(model)
     allpts = muscle["points"]
     active = [point_is_active(p, values) for p in allpts]
     # path nodes: [kind, wrap index or point index, body, location, wrap length]
@@ -1659,13 +1675,10 @@ def assign_wraps(model, muscle, kept_points, x0):
     """For each PathWrap choose the path segment (between two kept points) it acts on: within the
     PathWrap's point range, the segment passing closest to the wrap centre at the default pose.
     Returns {segment index: (wrap object body, wrap object)}; one wrap per segment."""
-    wrap_objects = {}
-    for b in model.body_order:
-        for w in model.bodies[b]["wraps"]:
-            wrap_objects[w["name"]] = (b, w)
+    objects = wrap_objects(model)
     best = {}
     for pw in muscle["wraps"]:
-        body, w = wrap_objects[pw["object"]]
+        body, w = objects[pw["object"]]
         centre = tf_point(x0[body], w["translation"])
         lo, hi = pw["range"]
         choices = []
@@ -2287,12 +2300,6 @@ class Converter:
 
     # --- bodies ------------------------------------------------------------------------------
 
-    def relocated_body(self, body):
-        """Patella bodies follow the knee through coupler constraints that make them rigid with
-        the tibia (patfem_flexion = knee_flexion + 1.57 about the same femoral axis, other patfem
-        coordinates locked): they become jointless children of the tibia-side body."""
-        return {"patella": "tibial_tray", "patella_l": "tibia_l"}.get(body)
-
     def build_paths(self):
         m = self.model
         for mus in m.muscles:
@@ -2328,7 +2335,7 @@ class Converter:
                     geom = self.wrap_geom_name(body, w)
                     side = self.side_site(body, w)
                     elements.append(("geom", geom, side))
-            if fit and not any(e[0] == "geom" and e[1] == mus["name"] + "_wrap"
+            if fit and not any(e[0] == "geom" and e[1] == fitted_part_names(mus["name"], 0)[0]
                                for e in elements):  # the slot must be one of the path's wraps
                 raise SystemExit("osim2mjcf.py: --wrap-fit: %s's fitted wrap (slot %d) is not a "
                                  "wrap of its path" % (mus["name"], fit["slot"]))
@@ -2336,24 +2343,22 @@ class Converter:
 
     def fitted_wrap(self, muscle, fit):
         """The muscle's own wrap geoms (with side sites) and the via sites between them, as
-        scripts/fit_wraps.py placed them (names as its part_names: <muscle>_wrap, _wrap2, ...,
-        _wrap_side, <muscle>_via2); returns their tendon elements in path order."""
+        scripts/fit_wraps.py placed them (names: fitted_part_names); returns their tendon
+        elements in path order."""
         elements = []
         for k, part in enumerate(fit["parts"]):
-            tag = "" if k == 0 else str(k + 1)
+            name, side_name, via_name = fitted_part_names(muscle, k)
             if part["kind"] == "via":
-                name = "%s_via%s" % (muscle, tag)
-                self.sites.setdefault(part["body"], []).append((name, part["pos"]))
-                elements.append(("site", name))
+                self.sites.setdefault(part["body"], []).append((via_name, part["pos"]))
+                elements.append(("site", via_name))
                 continue
-            name = "%s_wrap%s" % (muscle, tag)
             self.wrap_geoms.setdefault(part["body"], []).append({
                 "name": name, "type": part["type"], "radius": part["size"][0],
                 "half": part["size"][1] if part["type"] == "cylinder" else 0.0,
                 "pos": part["pos"], "quat": part["quat"]})
             side = None
             if part["side"] is not None:
-                side = name + "_side"
+                side = side_name
                 self.sites.setdefault(part["body"], []).append((side, part["side"]))
             elements.append(("geom", name, side))
         return elements
@@ -2396,7 +2401,7 @@ class Converter:
             out.append(pad + "  " + self.joint_xml(jt))
         self.emit_body_content(out, body, indent + 1)
         for child, cj, crev in self.children.get(body, []):
-            if self.relocated_body(child):
+            if relocated_body(child):
                 continue
             self.emit_body(out, child, cj, crev, indent + 1)
         for moved, host in (("patella", "tibial_tray"), ("patella_l", "tibia_l")):

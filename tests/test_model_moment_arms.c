@@ -340,7 +340,10 @@ int main(void) {
       if (!strcmp(r->coord, "length")) {
         double model = d->ten_length[t], e = fabs(model - r->value_wrap);
         const jump* jp = r->wraps ? find_jump(r->muscle) : NULL;
-        double tol = jp ? jp->length_tol : r->wraps ? WRAP_LENGTH_TOL : al ? al->length_tol : TOL_EXACT;
+        double tol = jp         ? jp->length_tol
+                     : r->wraps ? WRAP_LENGTH_TOL
+                     : al       ? al->length_tol
+                                : TOL_EXACT;
         s->dl = e > s->dl ? e : s->dl;
         double es = fabs(model - r->value);
         s->dl_straight = es > s->dl_straight ? es : s->dl_straight;

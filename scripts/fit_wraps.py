@@ -60,6 +60,9 @@ STEP_TILT = 0.3
 MAXFEV = 2500           # evaluations per refinement
 SCREEN_MAXFEV = 600     # evaluations per start
 REFINED = 2             # best starts refined
+NAN_EVERY = 3           # --check's NaN scan: every NAN_EVERY-th trial frame,
+NAN_SCALES = (1e-6, 1e-3, 0.05)  # perturbed by these standard deviations (rad),
+NAN_SAMPLES = 60        # this many times each
 TWO_WRAP_ABOVE = 0.9    # max |e| of the best single wrap above which two wraps are tried
 
 
@@ -400,6 +403,32 @@ def two_wrap_starts(model, mus, first_site, single):
     return out
 
 
+def nan_scan(args, frames, muscles):
+    """Count the poses where a muscle's MuJoCo length or moment arm is not finite: every
+    NAN_EVERY-th trial frame, each coordinate perturbed NAN_SAMPLES times by a normal deviate of
+    each scale in NAN_SCALES (rad; 1 % of that in m for translations), a fixed seed. Returns
+    (poses scanned, [(muscle, non-finite poses)])."""
+    rng = np.random.default_rng(0)
+    probe = Probe(args.probe, args.model, [])
+    bad = {}
+    scanned = 0
+    for _, base in frames[::NAN_EVERY]:
+        probe.set("clear")
+        for scale in NAN_SCALES:
+            for _ in range(NAN_SAMPLES):
+                pose = [base[j] + rng.normal() * scale * (0.01 if j in cv.TRANSLATIONS else 1.0)
+                        for j in probe.joints]
+                probe.set("pose " + vec(pose))
+        scanned += NAN_SAMPLES * len(NAN_SCALES)
+        for mus in muscles:
+            rows = probe.eval(mus["name"])
+            n = int(np.sum(~np.isfinite(rows[:, :-1]).all(axis=1)))
+            if n:
+                bad[mus["name"]] = bad.get(mus["name"], 0) + n
+    probe.close()
+    return scanned, sorted(bad.items())
+
+
 def fit_variant(args, base, model_dir, poses, name, slot, r, start, **options):
     """fit_start on the model with `start` in place of the muscle's wrap (written, probed,
     removed); returns fit_start's (objective, max |e|, x, fit)."""
@@ -453,7 +482,9 @@ def main():
     ap.add_argument("--cache", default=None, help="reference cache (json) to reuse")
     ap.add_argument("--check", action="store_true",
                     help="fit nothing: print each wrapping muscle's max |e| of --model over the "
-                         "poses; exit 1 if any is above 1")
+                         "poses and scan perturbed trial poses for non-finite paths; exit 1 if "
+                         "any max |e| is above 1, a path site sits within 2 mm of a wrap "
+                         "surface or a path is not finite")
     args = ap.parse_args()
     if not os.access(args.probe, os.X_OK):
         ap.error("--probe %s: not an executable (cmake --build build --target path_probe)"
@@ -531,7 +562,12 @@ def main():
     if args.check:
         print("%s: largest max |e| %.2f over %d muscles and %d poses (1 = the tolerance)" % (
             args.model, worst, len(muscles), len(idx)))
-        sys.exit(1 if worst > 1.0 else 0)
+        scanned, bad = nan_scan(args, frames, muscles)
+        print("%s: NaN scan: %d poses (one trial frame in %d, perturbed by %s rad, 1 %% of that "
+              "in m), non-finite lengths or moment arms: %s" % (
+                  args.model, scanned, NAN_EVERY, " / ".join("%g" % v for v in NAN_SCALES),
+                  ", ".join("%s %d" % b for b in bad) or "none"))
+        sys.exit(1 if worst > 1.0 or bad else 0)
     write_out(args, idx, trial, results)
 
 

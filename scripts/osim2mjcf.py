@@ -42,6 +42,9 @@ MODEL_COORDINATES = [
     "lumbar_extension", "lumbar_bending", "lumbar_rotation",
 ]
 
+# the coordinates in m (the others in rad; the trial's IK in degrees)
+TRANSLATIONS = ("pelvis_tx", "pelvis_ty", "pelvis_tz", "knee_tx", "knee_ty", "knee_tz")
+
 # secondary right-knee coordinates: placeholder springs until a knee-contact model replaces them
 KNEE_SECONDARY = {
     # name: (stiffness N m/rad or N/m, damping N m s/rad or N s/m)
@@ -1428,8 +1431,7 @@ def read_trial(path):
         pose = {}
         for c in MODEL_COORDINATES:
             v = rec[c]
-            pose[c] = v if c in ("pelvis_tx", "pelvis_ty", "pelvis_tz", "knee_tx", "knee_ty",
-                                 "knee_tz") else math.radians(v)
+            pose[c] = v if c in TRANSLATIONS else math.radians(v)
         frames.append((rec["time"], pose))
     return frames
 
@@ -1844,8 +1846,7 @@ def model_path_lengths(gaitsim, model_xml, frames):
     optimal fibre length; mjmodels/README.md, "Tendon slack lengths")."""
     import tempfile
     samples = trial_samples(frames)
-    translations = ("pelvis_tx", "pelvis_ty", "pelvis_tz", "knee_tx", "knee_ty", "knee_tz")
-    rows = [[t] + [pose[c] if c in translations else math.degrees(pose[c])
+    rows = [[t] + [pose[c] if c in TRANSLATIONS else math.degrees(pose[c])
                    for c in MODEL_COORDINATES] for t, pose in samples]
     folder = os.path.dirname(os.path.abspath(model_xml))
     fd, pose_file = tempfile.mkstemp(prefix=".trial_poses.", suffix=".mot", dir=folder)

@@ -27,7 +27,9 @@ static const char* kBalanceUsage =
     "trial's grf.mot. Prints, for each foot's single stance (its vertical force above 20 N, the\n"
     "other's not): the centre of pressure against the hip centre and the whole-body centre of\n"
     "mass (cm, + lateral), the hip abductors' net moment (N m), the ground reaction's frontal\n"
-    "moment about the centre of mass; over the stride: the frontal angular momentum about the\n"
+    "moment about the centre of mass; through each foot's stance: the knee's net moment about\n"
+    "knee_adduction (the 6-DOF knee only; what its contact, ligaments and muscles supply\n"
+    "together); over the stride: the frontal angular momentum about the\n"
     "centre of mass, lumbar_bending, the trunk's sway about the centre of mass, and the pelvis\n"
     "residuals (zero for a dynamically consistent motion and load).\n";
 
@@ -142,7 +144,7 @@ int gs_cmd_balance(int argc, char** argv) {
       a[i * nv + k] = (v[i1 * nv + k] - v[i0 * nv + k]) / (t.time[i1] - t.time[i0]);
   }
   stat cop_hip[2] = {0}, cop_com[2] = {0}, abd[2] = {0}, mom[2] = {0}, ang = {0}, bend = {0},
-       sway = {0}, resf = {0}, resm = {0};
+       sway = {0}, resf = {0}, resm = {0}, knee[2] = {{0}};
   double weight = mj_getTotalmass(m) * mju_norm3(m->opt.gravity);
   for (int i = 0; i < n; i++) {
     mj_resetData(m, d);  // only the coordinates and speeds matter to the balance
@@ -153,6 +155,7 @@ int gs_cmd_balance(int argc, char** argv) {
     gsBalance b;
     gs_balance_eval(m, d, &spec, a + i * nv, load, &b);
     for (int s = 0; s < 2; s++) {
+      if (load[s].loaded) add(&knee[s], b.knee_adduction_moment[s]);
       if (!load[s].loaded || load[1 - s].loaded) continue;  // single stance of foot s
       add(&cop_hip[s], b.cop_lateral_hip[s]);
       add(&cop_com[s], b.cop_lateral_com[s]);
@@ -178,6 +181,12 @@ int gs_cmd_balance(int argc, char** argv) {
          "%.1f / %.1f |\n", mean(&abd[0]), abd[0].hi, mean(&abd[1]), abd[1].hi);
   printf("| ground reaction's frontal moment about the CoM, peak / RMS (N m) | %.1f / %.1f | "
          "%.1f / %.1f |\n", mom[0].hi, rms(&mom[0]), mom[1].hi, rms(&mom[1]));
+  printf("| knee's net moment about knee_adduction through stance, mean / min / max (N m) |");
+  for (int s = 0; s < 2; s++) {
+    if (knee[s].n) printf(" %.1f / %.1f / %.1f |", mean(&knee[s]), knee[s].lo, knee[s].hi);
+    else printf(" - (no knee_adduction%s) |", s == 0 ? "" : "_l");
+  }
+  printf("\n");
   printf("frontal angular momentum about the CoM: %.2f ... %.2f N m s\n", ang.lo, ang.hi);
   printf("lumbar_bending: %.1f ... %.1f deg\n", bend.lo * 180 / M_PI, bend.hi * 180 / M_PI);
   printf("trunk CoM sway about the whole-body CoM (range): %.1f cm\n", 100 * (sway.hi - sway.lo));

@@ -22,6 +22,8 @@ int gs_balance_spec(const mjModel* m, gsBalanceSpec* spec, char* err, int errsz)
       find(m, mjOBJ_JOINT, "hip_adduction_l", &spec->hip_joint[1], err, errsz))
     return -1;
   spec->lumbar_bending = mj_name2id(m, mjOBJ_JOINT, "lumbar_bending");
+  spec->knee_adduction[0] = mj_name2id(m, mjOBJ_JOINT, "knee_adduction");
+  spec->knee_adduction[1] = mj_name2id(m, mjOBJ_JOINT, "knee_adduction_l");
   for (int s = 0; s < 2; s++) {
     spec->foot_body[s] = -1;
     for (int g = 0; g < m->ngeom && spec->foot_body[s] < 0; g++)
@@ -74,8 +76,11 @@ void gs_balance_eval(const mjModel* m, mjData* d, const gsBalanceSpec* spec, con
     out->cop_lateral_com[s] = side * (load[s].cop[1] - com[1]);
   }
   mju_subFrom(tau, ext, m->nv);
-  for (int s = 0; s < 2; s++)
+  for (int s = 0; s < 2; s++) {
     out->hip_adduction_moment[s] = tau[m->jnt_dofadr[spec->hip_joint[s]]];
+    int knee = spec->knee_adduction[s];
+    out->knee_adduction_moment[s] = knee >= 0 ? tau[m->jnt_dofadr[knee]] : NAN;
+  }
   // the root's six dofs: pelvis_tx, _ty, _tz (slides) then pelvis_rz, _rx, _ry (hinges)
   int r0 = m->body_dofadr[spec->root_body], six = m->body_dofnum[spec->root_body] == 6;
   for (int k = 0; k < 3; k++) {

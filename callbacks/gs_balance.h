@@ -39,6 +39,7 @@ typedef struct gsBalanceSpec_ {
   int hip_joint[2];     // right, left: hip_adduction, hip_adduction_l
   int trunk_body;       // torso
   int lumbar_bending;   // joint lumbar_bending, -1 when absent
+  int knee_adduction[2];  // right, left: joint knee_adduction(_l), -1 when absent (1-DOF knee)
 } gsBalanceSpec;
 
 // The balance at one instant (index 0 right, 1 left).
@@ -50,6 +51,9 @@ typedef struct gsBalance_ {
   double cop_lateral_com[2];    // centre of pressure minus CoM, lateral (m), NAN unloaded
   double hip_adduction_moment[2];  // net moment about hip_adduction (N m; > 0 adducts, so the
                                    // abductors supply its negative)
+  double knee_adduction_moment[2];  // net moment about knee_adduction(_l) (N m, about the joint's
+                                    // own axis), NAN without the joint: what the knee's contact,
+                                    // ligaments and muscles supply together
   double trunk_lateral;         // trunk's CoM minus the whole-body CoM along y (m, + left)
   double lumbar_bending;        // lumbar_bending (rad), NAN when absent
   double residual_force[3];     // tau of pelvis_tx, _ty, _tz (N; slide axes, world)

@@ -77,6 +77,13 @@ int main(void) {
   gs_balance_eval(m, d, &spec, zero, moved, &b2);
   EXPECT_REL(-axis_x * (-delta) * W, b2.hip_adduction_moment[0] - b.hip_adduction_moment[0],
              1e-9, 1e-9);
+  // the right knee's (6-DOF) moment about knee_adduction changes alike; the left knee has none
+  EXPECT_TRUE(spec.knee_adduction[0] >= 0 && spec.knee_adduction[1] < 0);
+  double knee_x = d->xaxis[3 * spec.knee_adduction[0]];
+  EXPECT_TRUE(fabs(knee_x) > 0.9);  // about the forward axis
+  EXPECT_REL(-knee_x * (-delta) * W,
+             b2.knee_adduction_moment[0] - b.knee_adduction_moment[0], 1e-9, 1e-9);
+  EXPECT_TRUE(isnan(b.knee_adduction_moment[1]));
   EXPECT_NEAR(delta, b2.cop_lateral_hip[0] - b.cop_lateral_hip[0], 1e-12);
   EXPECT_NEAR(delta, b2.cop_lateral_com[0], 1e-12);
   // the residual moment it leaves is W delta about the forward axis

@@ -10,7 +10,9 @@ geom (and side site) and fits their placement, radius and axis so that MuJoCo's 
 OpenSim's wrapped path (the converter's port, `wrapped_path`) over the trial:
 
   minimise  mean e^2 + 10 mean max(0, |e| - 0.5)^2,  e = (L - L_ref) / 5 mm  and
-            (r - r_ref) / max(5 mm, 0.15 |r_ref|) over every fitting pose and primary coordinate
+            (r - r_ref) / max(5 mm, 0.15 |r_ref|) over every fitting pose and every coordinate
+            the muscle crosses, the right knee's secondary rotations included (not through the
+            patella), its translations not
 
 (the tolerance of issue #20 item 1, enforced by tests/test_model_moment_arms.c). Fitting poses:
 every --every-th frame of the trial's IK plus the reference poses of jw_poses.csv. Starts: each
@@ -18,14 +20,17 @@ of the muscle's OpenSim wrap objects as the surrogate (on its own body), without
 with one at 1.5 radii along each axis perpendicular to the cylinder (each axis of a sphere); each
 start is refined by Nelder-Mead over the geom's position (m), log radius, axis tilt (rad) and the
 side site's position (m), evaluated by MuJoCo itself (build/path_probe, geometry moved in place).
-Muscles whose converter surrogate already meets the tolerance with a margin (max |e| <= --keep)
-keep it. Writes mjmodels/reference/jw_wrap_fit.json, which scripts/osim2mjcf.py reads
-(--wrap-fit); deterministic (fixed starts, no random numbers).
+A refined fit is kept only if its length is continuous (no step above JUMP_TOL along lines
+through trial poses). Where one wrap stays above TWO_WRAP_ABOVE, two wraps with a via site, in the
+order of the body chain; then a second pass from the fit of a muscle over the same OpenSim
+objects. Muscles whose converter surrogate already meets the tolerance with a margin (max |e| <=
+--keep) keep it. Writes mjmodels/reference/jw_wrap_fit.json, which scripts/osim2mjcf.py reads
+(--wrap-fit); deterministic (fixed starts, fixed seeds).
 
 usage (mjmodels/README.md, "Fitted wraps", has the whole regeneration):
   fit_wraps.py --osim .../JW_AllBody_scaled.osim --model mjmodels/.fit_base.xml --every 20
          [--probe build/path_probe] [--out mjmodels/reference/jw_wrap_fit.json]
-         [--muscles a,b] [--cache /tmp/wrap_ref.json]
+         [--muscles a,b] [--cache /tmp/wrap_ref.json] [--previous FILE]
   fit_wraps.py --osim .../JW_AllBody_scaled.osim --check --every 5    (the written model)
 --model is the converter's model without fitted wraps (osim2mjcf.py --wrap-fit none); with
 --check, the model to measure (default mjmodels/jw_fullbody.xml).
@@ -48,7 +53,11 @@ import osim2mjcf as cv  # noqa: E402
 LENGTH_TOL = 0.005      # m: length tolerance (issue #20 item 1)
 ARM_TOL = 0.005         # m: moment-arm tolerance, or ARM_REL of |r_ref| where larger
 ARM_REL = 0.15
-SECONDARY = ("knee_adduction", "knee_rotation", "knee_tx", "knee_ty", "knee_tz")
+KNEE_TRANSLATIONS = ("knee_tx", "knee_ty", "knee_tz")  # dL/dq = direction cosines (m/m): not
+                        # moment arms; not fitted (MuJoCo's gastrocnemius path cannot follow
+                        # OpenSim's two stacked wraps there, mjmodels/README.md)
+COORDINATES = ("crossed; the right knee's rotations included but through the patella, its "
+               "translations not")  # (the reference cache's key)
 SIDE_REACH = 1.5        # side site distance from the axis (radii)
 SIDE_MAX = 0.1          # side sites stay within this distance of their geom's centre (m)
 SIDE_CLEAR = 0.2        # ... and outside its surface by at least this fraction of the radius
@@ -64,6 +73,14 @@ NAN_EVERY = 3           # --check's NaN scan: every NAN_EVERY-th trial frame,
 NAN_SCALES = (1e-6, 1e-3, 0.05)  # perturbed by these standard deviations (rad),
 NAN_SAMPLES = 60        # this many times each
 TWO_WRAP_ABOVE = 0.9    # max |e| of the best single wrap above which two wraps are tried
+JUMP_SCALE = 0.05       # continuity scan: from every NAN_EVERY-th trial frame a line along a
+                        # random direction (this standard deviation per coordinate, rad; 1 % of
+                        # it in m for translations), fixed seed,
+JUMP_STEPS = 200        # sampled at this many poses (about 1 mrad apart),
+JUMP_TOL = 0.0005       # where a step of the length above this (m) is a jump: MuJoCo's wrap
+                        # switching sides or off (a side site's forced wrap whose tangent lines
+                        # cross), which no smooth path does in 1 mrad
+MAX_REFINED = 8         # refinements tried per muscle before giving up on a continuous fit
 
 
 def quat_mul(a, b):
@@ -127,7 +144,12 @@ def reference(model, muscles, poses, methods):
     """{muscle: {"coords": [...], "L": [pose], "r": [[pose][coord]]}} of OpenSim's wrapped path."""
     out = {}
     for mus in muscles:
-        coords = [c for c in cv.crossed_coordinates(model, mus) if c not in SECONDARY]
+        # the rotations of the right knee's secondary coordinates included (with the knee-contact
+        # model knee_adduction's moment arm moves load between the compartments), except through
+        # the patella: MuJoCo's is rigid with the tibia, the .osim's follows the femur in them
+        through_patella = any(cv.relocated_body(p["body"]) for p in mus["points"])
+        coords = [c for c in cv.crossed_coordinates(model, mus) if c not in KNEE_TRANSLATIONS
+                  and not (through_patella and c in cv.KNEE_SECONDARY)]
         lengths, arms = [], []
         for pose in poses:
             lengths.append(cv.wrapped_path(model, mus, pose, methods)[0])
@@ -364,11 +386,33 @@ def starts_for(model, mus, tendon_geom):
     return out
 
 
-def two_wrap_starts(model, mus, first_site, single):
+def chain_position(parents, first, last):
+    """{body: position} along the MJCF tree path from body `first` to body `last` (0 at first);
+    a body off the path takes the position of its nearest ancestor on it."""
+    def up(b):
+        out = [b]
+        while b in parents:
+            b = parents[b]
+            out.append(b)
+        return out
+    a, b = up(first), up(last)
+    common = next(x for x in a if x in b)
+    path = a[:a.index(common) + 1] + list(reversed(b[:b.index(common)]))
+    pos = {x: i for i, x in enumerate(path)}
+
+    def position(body):
+        return next(pos[x] for x in up(body) if x in pos)
+    return position
+
+
+def two_wrap_starts(model, mus, first_site, single, position):
     """Two wraps in sequence on one segment, which MuJoCo expresses only with a via site between
     them: the best single fit `single` (from one OpenSim object) and a surrogate of the muscle's
-    other wrap object, in path order (the object nearer the segment's first site first), with a
-    via site starting at the midpoint of the two centres (in the second object's body)."""
+    other wrap object, in path order, with a via site starting at the midpoint of the two
+    centres (in the second object's body). Path order: along the body chain from the segment's
+    first site to its last (`position`), so that the path never returns to a body it has left
+    (a loop femur -> tibia -> femur would pull the tibia with twice the tension); on one body,
+    the object nearer the first site first."""
     objects = cv.wrap_objects(model)
     zero = {c: model.default_value(c) if c in cv.KNEE_SECONDARY else 0.0
             for c in cv.MODEL_COORDINATES}
@@ -390,16 +434,25 @@ def two_wrap_starts(model, mus, first_site, single):
         cb = cv.tf_point(x0[body], centre)
         site = cv.tf_point(x0[first_site[0]], first_site[1])
         mid = [(ca[i] + cb[i]) / 2.0 for i in range(3)]
-        via = {"kind": "via", "body": body,
-               "pos": cv.tf_point(cv.tf_inv(x0[body]), mid)}
+        a_first = (position(a["body"]), math.dist(site, ca)) <= (position(body),
+                                                                  math.dist(site, cb))
+        second = body if a_first else a["body"]
+        via = {"kind": "via", "body": second, "pos": cv.tf_point(cv.tf_inv(x0[second]), mid)}
         r = spec["radius"]
         size = [r] if spec["type"] == "sphere" else [r, max(spec["half"], r)]
-        b_part = {"kind": "geom", "body": body, "type": spec["type"], "pos": centre,
-                  "quat": cv.quat_from_mat(spec["rot"]), "size": size, "side": None}
-        parts = [dict(a), via, b_part] if math.dist(site, ca) <= math.dist(site, cb) \
-            else [b_part, via, dict(a)]
-        out.append({"parts": parts, "from": "%s + %s%s" % (
-            single["from"], obj, " %+g half" % shift if shift else "")})
+        # the second geom without a side site or with one outside along each of its axes
+        axes = [0, 1] if spec["type"] == "cylinder" else [0, 1, 2]
+        sides = [None] + [[centre[i] + sgn * spec["rot"][i][ax] * SIDE_REACH * r
+                           for i in range(3)] for ax in axes for sgn in (1.0, -1.0)]
+        # the single fit's geom with its side site (if any) and without
+        a_variants = [dict(a)] + ([dict(a, side=None)] if a["side"] is not None else [])
+        for a_part in a_variants:
+            for side in sides:
+                b_part = {"kind": "geom", "body": body, "type": spec["type"], "pos": centre,
+                          "quat": cv.quat_from_mat(spec["rot"]), "size": size, "side": side}
+                parts = [a_part, dict(via), b_part] if a_first else [b_part, dict(via), a_part]
+                out.append({"parts": parts, "from": "%s + %s%s" % (
+                    single["from"], obj, " %+g half" % shift if shift else "")})
     return out
 
 
@@ -442,8 +495,45 @@ def fit_variant(args, base, model_dir, poses, name, slot, r, start, **options):
     return result
 
 
+def jump_lines(frames):
+    """The continuity scan's lines: (base pose, direction) per NAN_EVERY-th trial frame."""
+    rng = np.random.default_rng(1)
+    out = []
+    for _, base in frames[::NAN_EVERY]:
+        d = {c: rng.normal() * JUMP_SCALE * (0.01 if c in cv.TRANSLATIONS else 1.0)
+             for c in sorted(base)}
+        out.append((base, d))
+    return out
+
+
+def largest_jump(probe, muscle, lines):
+    """The largest step (m) of the muscle's length between neighbouring poses of the lines."""
+    worst = 0.0
+    for base, d in lines:
+        probe.set("clear")
+        for t in np.linspace(0.0, 1.0, JUMP_STEPS):
+            probe.set("pose " + vec([base[j] + t * d.get(j, 0.0) for j in probe.joints]))
+        L = probe.eval(muscle)[:, 0]
+        worst = max(worst, float(np.max(np.abs(np.diff(L)))))
+    return worst
+
+
+def fit_jump(args, base, model_dir, name, slot, fit):
+    """largest_jump of the model with `fit` in place of the muscle's wrap."""
+    path = write_variant(base, model_dir, name, slot, fit)
+    try:
+        probe = Probe(args.probe, path, [])
+        jump = largest_jump(probe, name, args.jump_lines)
+        probe.close()
+    finally:
+        os.unlink(path)
+    return jump
+
+
 def fit_starts(args, base, model_dir, poses, name, slot, r, starts):
-    """Screen every start briefly, refine the REFINED best; returns (objective, max |e|, fit)."""
+    """Screen every start briefly, refine the REFINED best whose fits are continuous (no jump
+    in the continuity scan; at most MAX_REFINED refinements); returns (objective, max |e|,
+    fit)."""
     screened = []
     for start in starts:
         obj, emax, x, fit = fit_variant(args, base, model_dir, poses, name, slot, r, start,
@@ -451,14 +541,21 @@ def fit_starts(args, base, model_dir, poses, name, slot, r, starts):
         print("  from %-44s objective %.4f max |e| %.2f" % (describe(start), obj, emax),
               flush=True)
         screened.append((obj, emax, len(screened), start, x))
-    best = None
-    for obj, emax, _, start, x in sorted(screened, key=lambda t: (t[0], t[2]))[:REFINED]:
+    best, kept = None, 0
+    for obj, emax, _, start, x in sorted(screened, key=lambda t: (t[0], t[2]))[:MAX_REFINED]:
         obj, emax, x, fit = fit_variant(args, base, model_dir, poses, name, slot, r, start,
                                         x0=x)
-        print("  refined %-41s objective %.4f max |e| %.2f" % (describe(start), obj, emax),
-              flush=True)
+        jump = fit_jump(args, base, model_dir, name, slot, fit)
+        print("  refined %-41s objective %.4f max |e| %.2f, largest step %.2f mm%s" % (
+            describe(start), obj, emax, 1000 * jump, " (a jump: rejected)" if jump > JUMP_TOL
+            else ""), flush=True)
+        if jump > JUMP_TOL:
+            continue
         if best is None or (emax, obj) < (best[1], best[0]):
             best = (obj, emax, fit)
+        kept += 1
+        if kept == REFINED:
+            break
     return best
 
 
@@ -480,11 +577,16 @@ def main():
     ap.add_argument("--keep", type=float, default=0.8,
                     help="keep the converter's surrogate where max |e| is at most this")
     ap.add_argument("--cache", default=None, help="reference cache (json) to reuse")
+    ap.add_argument("--previous", default=None,
+                    help="an earlier fit file (json): a muscle this run leaves above the "
+                         "tolerance keeps its fit there when that is within it and continuous "
+                         "(marked \"kept from\" in the output)")
     ap.add_argument("--check", action="store_true",
                     help="fit nothing: print each wrapping muscle's max |e| of --model over the "
-                         "poses and scan perturbed trial poses for non-finite paths; exit 1 if "
-                         "any max |e| is above 1, a path site sits within 2 mm of a wrap "
-                         "surface or a path is not finite")
+                         "poses, scan perturbed trial poses for non-finite paths and lines "
+                         "through trial poses for jumps of the length; exit 1 if any max |e| is "
+                         "above 1, a path site sits within 2 mm of a wrap surface, a path is not "
+                         "finite or a length jumps")
     args = ap.parse_args()
     if not os.access(args.probe, os.X_OK):
         ap.error("--probe %s: not an executable (cmake --build build --target path_probe)"
@@ -493,6 +595,7 @@ def main():
                                           "ngait_og5", "IK_ngait_og5.csv")
     model = cv.OsimModel(args.osim)
     frames = cv.read_trial(trial)
+    args.jump_lines = jump_lines(frames)
     methods = cv.read_wrap_methods(args.osim)
     idx = sorted(set(range(0, len(frames), args.every)) | set(cv.reference_poses(frames)))
     poses = [frames[i][1] for i in idx]
@@ -504,16 +607,24 @@ def main():
     if args.cache and os.path.exists(args.cache):
         with open(args.cache) as f:
             ref = json.load(f)
-        if ref.get("poses") != idx or any(m["name"] not in ref["muscles"] for m in muscles):
+        if ref.get("poses") != idx or ref.get("coordinates") != COORDINATES or \
+                any(m["name"] not in ref["muscles"] for m in muscles):
             ref = None
     if ref is None:
-        ref = {"poses": idx, "muscles": reference(model, muscles, poses, methods)}
+        ref = {"poses": idx, "coordinates": COORDINATES,
+               "muscles": reference(model, muscles, poses, methods)}
         if args.cache:
             with open(args.cache, "w") as f:
                 json.dump(ref, f)
     base = ET.parse(args.model)
+    parent_of = {c: pb for pb in base.getroot().iter("body") for c in pb}
+    body_parents = {c.get("name"): pb.get("name") for c, pb in parent_of.items() if c.tag == "body"}
     model_dir = os.path.dirname(os.path.abspath(args.model))
-    results = {}
+    previous = {}
+    if args.previous:
+        with open(args.previous) as f:
+            previous = json.load(f)["muscles"]
+    results, surrogate_error = {}, {}
     base_probe = Probe(args.probe, args.model, poses)
     worst = 0.0
     for mus in muscles:
@@ -521,6 +632,7 @@ def main():
         r = ref["muscles"][name]
         rows0 = base_probe.eval(name)
         e0 = errors(r, base_probe.joints, rows0)
+        surrogate_error[name] = float(np.max(np.abs(e0)))
         # a path site near a wrap surface (inside or out) makes the wrap hang on a rounding;
         # one deep inside is consistent (MuJoCo never wraps that segment)
         near = float(np.min(np.abs(rows0[:, -1])))
@@ -544,19 +656,59 @@ def main():
         if best is not None and best[1] > TWO_WRAP_ABOVE:
             prev = tendon[slot - 1].get("site")
             site = [el for el in base.getroot().iter("site") if el.get("name") == prev][0]
-            parent = {c: pb for pb in base.getroot().iter("body") for c in pb}[site]
+            parent = parent_of[site]
             first_site = (parent.get("name"), [float(v) for v in site.get("pos").split()])
+            after = tendon[slot + 1].get("site")
+            last = parent_of[[el for el in base.getroot().iter("site")
+                              if el.get("name") == after][0]].get("name")
+            position = chain_position(body_parents, first_site[0], last)
             two = fit_starts(args, base, model_dir, poses, name, slot, r,
-                             two_wrap_starts(model, mus, first_site, best[2]))
+                             two_wrap_starts(model, mus, first_site, best[2], position))
             if two is not None and (two[1], two[0]) < (best[1], best[0]):
                 best = two
         if best is not None and best[1] < np.max(np.abs(e0)):
-            geom = best[2]
-            geom["slot"] = slot
-            geom["max_error"] = best[1]
-            geom["converter_max_error"] = float(np.max(np.abs(e0)))
-            results[name] = geom
-            print("  -> %s: max |e| %.2f (converter %.2f)" % (name, best[1], np.max(np.abs(e0))))
+            keep_fit(results, name, best, slot, float(np.max(np.abs(e0))))
+            write_out(args, idx, trial, results)
+    # second pass: a muscle still above the tolerance starts from the fit of a muscle that wraps
+    # over the same OpenSim objects (the other head of a pair), as is and mirrored medio-laterally
+    for mus in muscles:
+        name = mus["name"]
+        if args.check or name not in results or results[name]["max_error"] <= 1.0:
+            continue
+        objects = sorted(pw["object"] for pw in mus["wraps"])
+        shared = [other for other in muscles if other["name"] != name and
+                  other["name"] in results and
+                  sorted(pw["object"] for pw in other["wraps"]) == objects]
+        starts = [s for other in shared for s in shared_starts(other["name"],
+                                                               results[other["name"]])]
+        if not starts:
+            continue
+        slot = results[name]["slot"]
+        best = fit_starts(args, base, model_dir, poses, name, slot, ref["muscles"][name], starts)
+        if best is not None and best[1] < results[name]["max_error"]:
+            keep_fit(results, name, best, slot, results[name]["converter_max_error"])
+            write_out(args, idx, trial, results)
+    # a muscle still above the tolerance keeps an earlier fit that is within it and continuous
+    for mus in muscles:
+        name = mus["name"]
+        old = previous.get(name)
+        now = results[name]["max_error"] if name in results else surrogate_error.get(name, 0.0)
+        if args.check or old is None or old["max_error"] > 1.0 or now <= 1.0:
+            continue
+        r = ref["muscles"][name]
+        path = write_variant(base, model_dir, name, old["slot"], old)
+        try:
+            probe = Probe(args.probe, path, poses)
+            emax = float(np.max(np.abs(errors(r, probe.joints, probe.eval(name)))))
+            probe.close()
+        finally:
+            os.unlink(path)
+        jump = fit_jump(args, base, model_dir, name, old["slot"], old)
+        print("%-10s previous fit: max |e| %.2f, largest step %.2f mm" % (
+            name, emax, 1000 * jump))
+        if emax <= 1.0 and jump <= JUMP_TOL:
+            kept = dict(old, max_error=emax, kept_from=os.path.basename(args.previous))
+            results[name] = kept
             write_out(args, idx, trial, results)
     base_probe.close()
     if args.check:
@@ -567,8 +719,43 @@ def main():
               "in m), non-finite lengths or moment arms: %s" % (
                   args.model, scanned, NAN_EVERY, " / ".join("%g" % v for v in NAN_SCALES),
                   ", ".join("%s %d" % b for b in bad) or "none"))
-        sys.exit(1 if worst > 1.0 or bad else 0)
+        probe = Probe(args.probe, args.model, [])
+        jumps = [(mus["name"], largest_jump(probe, mus["name"], args.jump_lines))
+                 for mus in muscles]
+        probe.close()
+        jumped = ["%s %.2f mm" % (n, 1000 * j) for n, j in jumps if j > JUMP_TOL]
+        print("%s: continuity scan: %d lines of %d poses (from one trial frame in %d, %g rad), "
+              "largest length step %.3f mm; jumps above %.1f mm: %s" % (
+                  args.model, len(args.jump_lines), JUMP_STEPS, NAN_EVERY, JUMP_SCALE,
+                  1000 * max(j for _, j in jumps), 1000 * JUMP_TOL, ", ".join(jumped) or "none"))
+        sys.exit(1 if worst > 1.0 or bad or jumped else 0)
     write_out(args, idx, trial, results)
+
+
+def keep_fit(results, name, best, slot, converter_error):
+    geom = best[2]
+    geom["slot"] = slot
+    geom["max_error"] = best[1]
+    geom["converter_max_error"] = converter_error
+    results[name] = geom
+    print("  -> %s: max |e| %.2f (converter %.2f)" % (name, best[1], converter_error))
+
+
+def shared_starts(other, fit):
+    """Starts from muscle `other`'s fitted parts: as they are, and mirrored across the body
+    frames' sagittal plane (z -> -z; a rotation (w, x, y, z) -> (w, -x, -y, z))."""
+    def mirrored(part):
+        q = dict(part)
+        q["pos"] = [part["pos"][0], part["pos"][1], -part["pos"][2]]
+        if part["kind"] == "geom":
+            w, x, y, z = part["quat"]
+            q["quat"] = [w, -x, -y, z]
+            if part["side"] is not None:
+                q["side"] = [part["side"][0], part["side"][1], -part["side"][2]]
+        return q
+    parts = [{k: v for k, v in p.items()} for p in fit["parts"]]
+    return [{"parts": parts, "from": "%s's fit" % other},
+            {"parts": [mirrored(p) for p in parts], "from": "%s's fit mirrored" % other}]
 
 
 def write_out(args, idx, trial, results):
@@ -576,8 +763,9 @@ def write_out(args, idx, trial, results):
            "source": "OpenSim wrapped paths of %s (scripts/osim2mjcf.py wrapped_path) at %d "
                      "frames of %s" % (os.path.basename(args.osim), len(idx),
                                        os.path.basename(trial)),
-           "tolerance": "length %g m; moment arm %g m or %g of |r_ref|" % (
-               LENGTH_TOL, ARM_TOL, ARM_REL),
+           "tolerance": "length %g m; moment arm %g m or %g of |r_ref| about the coordinates: "
+                        "%s" % (
+               LENGTH_TOL, ARM_TOL, ARM_REL, COORDINATES),
            "frames": "body frames of the .osim (= the MJCF's bodies); quat w x y z",
            "muscles": results}
     with open(args.out, "w") as f:

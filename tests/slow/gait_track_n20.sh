@@ -15,10 +15,10 @@
 #     0.29 cm, 0.032 / 0.012 / 0.015 BW, 4.33 deg, 0.27 BW): pelvis rotations <= 1 deg [0.21],
 #     pelvis translations <= 0.5 cm [0.20], GRF fore-aft, vertical and mediolateral <= 0.05 BW
 #     each [0.02, 0.04, 0.02], other joints <= 6 deg [1.98]; the right knee contact force,
-#     measured in vivo and not tracked: RMS <= 0.45 BW [0.32] and its peak 1.5-4 BW (the eTibia's
-#     2.4 BW). The knee bound was 0.4 until the gastrocnemii got OpenSim's wrapped paths
-#     (mjmodels/README.md, "Fitted wraps"): 20-node RMS 0.330 -> 0.420 BW, the lateral
-#     compartment's push-off load (issue #20 item 3).
+#     measured in vivo and not tracked: RMS <= 0.40 BW [0.32] and its peak 1.5-4 BW (the eTibia's
+#     2.4 BW). Measured 0.372 BW, peak 2.58 (mjmodels/README.md, "Fitted wraps": gastrocnemii
+#     with OpenSim's paths about every knee rotation; 0.420 while their frontal moment arms had
+#     the wrong sign).
 # About 50 s on 2 cores.
 # usage: gait_track_n20.sh GAITSIM SOURCE_DIR
 set -u
@@ -68,7 +68,7 @@ within("speed_mps", 1.1, 1.45, s["speed_mps"])
 r = s["rms"]
 for key, hi in (("pelvis_rot_deg", 1), ("pelvis_trans_cm", 0.5), ("grf_ap_bw", 0.05),
                 ("grf_v_bw", 0.05), ("grf_ml_bw", 0.05), ("joint_rot_deg", 6),
-                ("knee_contact_bw", 0.45)):
+                ("knee_contact_bw", 0.40)):
     within("rms." + key, 0, hi, r.get(key))
 within("peak_knee_contact_r_bw", 1.5, 4.0, s["peak_knee_contact_r_bw"])
 print("status %s, violation %.3g, rms %s, peak knee %.2f BW"

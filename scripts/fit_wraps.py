@@ -482,17 +482,32 @@ def nan_scan(args, frames, muscles):
     return scanned, sorted(bad.items())
 
 
-def fit_variant(args, base, model_dir, poses, name, slot, r, start, **options):
+def fit_variant(args, base, model_dir, poses, name, slot, r, start, scan=False, **options):
     """fit_start on the model with `start` in place of the muscle's wrap (written, probed,
-    removed); returns fit_start's (objective, max |e|, x, fit)."""
+    removed); returns fit_start's (objective, max |e|, x, fit) and, with scan, the fit's
+    largest_jump (the probe ends at the fitted geometry), else None."""
     path = write_variant(base, model_dir, name, slot, start)
     try:
         probe = Probe(args.probe, path, poses)
         result = fit_start(probe, name, r, start, **options)
+        jump = largest_jump(probe, name, args.jump_lines) if scan else None
         probe.close()
     finally:
         os.unlink(path)
-    return result
+    return result + (jump,)
+
+
+def measure_fit(args, base, model_dir, poses, name, slot, r, fit):
+    """(max |e|, largest_jump) of the model with `fit` in place of the muscle's wrap."""
+    path = write_variant(base, model_dir, name, slot, fit)
+    try:
+        probe = Probe(args.probe, path, poses)
+        emax = float(np.max(np.abs(errors(r, probe.joints, probe.eval(name)))))
+        jump = largest_jump(probe, name, args.jump_lines)
+        probe.close()
+    finally:
+        os.unlink(path)
+    return emax, jump
 
 
 def jump_lines(frames):
@@ -518,34 +533,21 @@ def largest_jump(probe, muscle, lines):
     return worst
 
 
-def fit_jump(args, base, model_dir, name, slot, fit):
-    """largest_jump of the model with `fit` in place of the muscle's wrap."""
-    path = write_variant(base, model_dir, name, slot, fit)
-    try:
-        probe = Probe(args.probe, path, [])
-        jump = largest_jump(probe, name, args.jump_lines)
-        probe.close()
-    finally:
-        os.unlink(path)
-    return jump
-
-
 def fit_starts(args, base, model_dir, poses, name, slot, r, starts):
     """Screen every start briefly, refine the REFINED best whose fits are continuous (no jump
     in the continuity scan; at most MAX_REFINED refinements); returns (objective, max |e|,
     fit)."""
     screened = []
     for start in starts:
-        obj, emax, x, fit = fit_variant(args, base, model_dir, poses, name, slot, r, start,
-                                        maxfev=SCREEN_MAXFEV, restarts=1)
+        obj, emax, x, fit, _ = fit_variant(args, base, model_dir, poses, name, slot, r, start,
+                                           maxfev=SCREEN_MAXFEV, restarts=1)
         print("  from %-44s objective %.4f max |e| %.2f" % (describe(start), obj, emax),
               flush=True)
         screened.append((obj, emax, len(screened), start, x))
     best, kept = None, 0
     for obj, emax, _, start, x in sorted(screened, key=lambda t: (t[0], t[2]))[:MAX_REFINED]:
-        obj, emax, x, fit = fit_variant(args, base, model_dir, poses, name, slot, r, start,
-                                        x0=x)
-        jump = fit_jump(args, base, model_dir, name, slot, fit)
+        obj, emax, x, fit, jump = fit_variant(args, base, model_dir, poses, name, slot, r,
+                                              start, scan=True, x0=x)
         print("  refined %-41s objective %.4f max |e| %.2f, largest step %.2f mm%s" % (
             describe(start), obj, emax, 1000 * jump, " (a jump: rejected)" if jump > JUMP_TOL
             else ""), flush=True)
@@ -695,15 +697,8 @@ def main():
         now = results[name]["max_error"] if name in results else surrogate_error.get(name, 0.0)
         if args.check or old is None or old["max_error"] > 1.0 or now <= 1.0:
             continue
-        r = ref["muscles"][name]
-        path = write_variant(base, model_dir, name, old["slot"], old)
-        try:
-            probe = Probe(args.probe, path, poses)
-            emax = float(np.max(np.abs(errors(r, probe.joints, probe.eval(name)))))
-            probe.close()
-        finally:
-            os.unlink(path)
-        jump = fit_jump(args, base, model_dir, name, old["slot"], old)
+        emax, jump = measure_fit(args, base, model_dir, poses, name, old["slot"],
+                                 ref["muscles"][name], old)
         print("%-10s previous fit: max |e| %.2f, largest step %.2f mm" % (
             name, emax, 1000 * jump))
         if emax <= 1.0 and jump <= JUMP_TOL:
@@ -753,7 +748,7 @@ def shared_starts(other, fit):
             if part["side"] is not None:
                 q["side"] = [part["side"][0], part["side"][1], -part["side"][2]]
         return q
-    parts = [{k: v for k, v in p.items()} for p in fit["parts"]]
+    parts = [dict(p) for p in fit["parts"]]
     return [{"parts": parts, "from": "%s's fit" % other},
             {"parts": [mirrored(p) for p in parts], "from": "%s's fit mirrored" % other}]
 

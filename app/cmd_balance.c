@@ -19,7 +19,7 @@
 #define BALANCE_STANCE_N 20.0  // a foot is in stance above this vertical force (N)
 
 static const char* kBalanceUsage =
-    "usage: gaitsim balance MODEL --pose FILE --grf GRF.mot\n\n"
+    "usage: gaitsim balance MODEL --pose FILE --grf GRF.mot [--rows]\n\n"
     "The frontal-plane balance of a gait by inverse dynamics under the given ground reactions,\n"
     "at every row of FILE (a solution's states.sto, or a trial's coordinates.mot; speeds missing\n"
     "from FILE and all accelerations by central differences of its rows). GRF.mot: OpenSim\n"
@@ -31,7 +31,14 @@ static const char* kBalanceUsage =
     "knee_adduction (the 6-DOF knee only; what its contact, ligaments and muscles supply\n"
     "together); over the stride: the frontal angular momentum about the\n"
     "centre of mass, lumbar_bending, the trunk's sway about the centre of mass, and the pelvis\n"
-    "residuals (zero for a dynamically consistent motion and load).\n";
+    "residuals (zero for a dynamically consistent motion and load).\n\n"
+    "  --rows   also a table of every loaded row of each foot: the centre of pressure in the\n"
+    "           foot's frame (forward, lateral), the mediolateral ground force (+ lateral)\n"
+    "           and, for a 6-DOF knee, the net moment about knee_adduction, the ground\n"
+    "           reaction's part of it and its pieces in the knee's frame\n"
+    "           (callbacks/gs_balance.h): the centre of pressure lateral of the knee centre,\n"
+    "           the force along the shank and along the knee's lateral axis, that axis's\n"
+    "           tilt (+ lateral end up)\n";
 
 // the ground reactions of the table at time, in the model world
 static void loads_at(const gsTable* g, const int* col, double time, gsFootLoad load[2]) {
@@ -64,16 +71,19 @@ static double rms(const stat* s) { return s->n ? sqrt(s->sumsq / s->n) : NAN; }
 int gs_cmd_balance(int argc, char** argv) {
   static const struct option options[] = {{"pose", required_argument, NULL, 'p'},
                                           {"grf", required_argument, NULL, 'g'},
+                                          {"rows", no_argument, NULL, 'r'},
                                           {"help", no_argument, NULL, 'h'},
                                           {NULL, 0, NULL, 0}};
   const char *pose = NULL, *grf = NULL;
+  int rows = 0;
   optind = 1;
   opterr = 0;
   int c;
-  while ((c = getopt_long(argc, argv, ":p:g:h", options, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, ":p:g:rh", options, NULL)) != -1) {
     switch (c) {
       case 'p': pose = optarg; break;
       case 'g': grf = optarg; break;
+      case 'r': rows = 1; break;
       case 'h': fputs(kBalanceUsage, stdout); return GS_EXIT_OK;
       default: return gs_opt_getopt_error("balance", c, argv);
     }
@@ -146,6 +156,14 @@ int gs_cmd_balance(int argc, char** argv) {
   stat cop_hip[2] = {0}, cop_com[2] = {0}, abd[2] = {0}, mom[2] = {0}, ang = {0}, bend = {0},
        sway = {0}, resf = {0}, resm = {0}, knee[2] = {{0}};
   double weight = mj_getTotalmass(m) * mju_norm3(m->opt.gravity);
+  gsBalance* all = rows ? (gsBalance*)malloc(sizeof(gsBalance) * (size_t)n) : NULL;
+  int* loaded = rows ? (int*)malloc(sizeof(int) * (size_t)(2 * n)) : NULL;
+  if (rows && (!all || !loaded)) {
+    fprintf(stderr, "gaitsim: balance: out of memory\n");
+    free(all);
+    free(loaded);
+    goto done;
+  }
   for (int i = 0; i < n; i++) {
     mj_resetData(m, d);  // only the coordinates and speeds matter to the balance
     mju_copy(d->qpos, q + i * nq, nq);
@@ -154,6 +172,11 @@ int gs_cmd_balance(int argc, char** argv) {
     loads_at(&g, col, t.time[i], load);
     gsBalance b;
     gs_balance_eval(m, d, &spec, a + i * nv, load, &b);
+    if (rows) {
+      all[i] = b;
+      loaded[2 * i] = load[0].loaded;
+      loaded[2 * i + 1] = load[1].loaded;
+    }
     for (int s = 0; s < 2; s++) {
       if (load[s].loaded) add(&knee[s], b.knee_adduction_moment[s]);
       if (!load[s].loaded || load[1 - s].loaded) continue;  // single stance of foot s
@@ -192,6 +215,36 @@ int gs_cmd_balance(int argc, char** argv) {
   printf("trunk CoM sway about the whole-body CoM (range): %.1f cm\n", 100 * (sway.hi - sway.lo));
   printf("pelvis residuals, RMS: force %.1f N (%.3f BW), moment %.1f N m\n", rms(&resf),
          rms(&resf) / weight, rms(&resm));
+  for (int s = 0; rows && s < 2; s++) {
+    int has_knee = spec.knee_adduction[s] >= 0 && spec.ankle_joint[s] >= 0;
+    double side = s == 0 ? -1.0 : 1.0;  // lateral: -y right, +y left
+    printf("\n%s foot, every loaded row (distances in cm, forces in N, moments in N m; the knee's "
+           "columns %s)\n", s == 0 ? "right" : "left",
+           has_knee ? "about its knee_adduction" : "empty: no knee_adduction");
+    printf("| time (s) | stride (%%) | centre of pressure in the foot, forward | and lateral | "
+           "knee's net knee_adduction moment | ground reaction's part | centre of pressure "
+           "lateral of the knee | force along the shank | force along the knee's lateral axis "
+           "| lateral axis tilt (deg) | mediolateral ground force |\n");
+    printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
+    for (int i = 0; i < n; i++) {
+      if (!loaded[2 * i + s]) continue;
+      const gsBalance* b = &all[i];
+      gsFootLoad load[2];
+      loads_at(&g, col, t.time[i], load);
+      printf("| %.4f | %.1f | %.2f | %.2f |", t.time[i],
+             100 * (t.time[i] - t.time[0]) / (t.time[n - 1] - t.time[0]),
+             100 * b->cop_foot_forward[s], 100 * b->cop_foot_lateral[s]);
+      if (has_knee)
+        printf(" %.2f | %.2f | %.2f | %.1f | %.1f | %.2f |", b->knee_adduction_moment[s],
+               b->knee_grf_moment[s], 100 * b->cop_lateral_knee[s], b->knee_axial_force[s],
+               b->knee_lateral_force[s], b->knee_lateral_tilt[s] * 180 / M_PI);
+      else
+        printf(" - | - | - | - | - | - |");
+      printf(" %.1f |\n", side * load[s].force[1]);
+    }
+  }
+  free(all);
+  free(loaded);
   status = GS_EXIT_OK;
 done:
   free(q);

@@ -24,6 +24,8 @@ int gs_balance_spec(const mjModel* m, gsBalanceSpec* spec, char* err, int errsz)
   spec->lumbar_bending = mj_name2id(m, mjOBJ_JOINT, "lumbar_bending");
   spec->knee_adduction[0] = mj_name2id(m, mjOBJ_JOINT, "knee_adduction");
   spec->knee_adduction[1] = mj_name2id(m, mjOBJ_JOINT, "knee_adduction_l");
+  spec->ankle_joint[0] = mj_name2id(m, mjOBJ_JOINT, "ankle_angle");
+  spec->ankle_joint[1] = mj_name2id(m, mjOBJ_JOINT, "ankle_angle_l");
   for (int s = 0; s < 2; s++) {
     spec->foot_body[s] = -1;
     for (int g = 0; g < m->ngeom && spec->foot_body[s] < 0; g++)
@@ -42,6 +44,29 @@ void gs_balance_from_opensim(const double os[3], double world[3]) {
   world[0] = x;
   world[1] = -z;
   world[2] = y;
+}
+
+// the ground reaction's part of knee s's moment and its pieces in the knee's frame (gs_balance.h)
+static void knee_frame(const mjData* d, const gsBalanceSpec* spec, int s, const gsFootLoad* load,
+                       const mjtNum* ext, const mjModel* m, gsBalance* out) {
+  out->knee_grf_moment[s] = out->cop_lateral_knee[s] = out->knee_lateral_force[s] = NAN;
+  out->knee_axial_force[s] = out->knee_lateral_tilt[s] = NAN;
+  int knee = spec->knee_adduction[s], ankle = spec->ankle_joint[s];
+  if (knee < 0 || ankle < 0 || !load->loaded) return;
+  const double* a = d->xaxis + 3 * knee;
+  const double* k = d->xanchor + 3 * knee;
+  double u[3], l[3], r[3];
+  mju_sub3(u, k, d->xanchor + 3 * ankle);
+  mju_addToScl3(u, a, -mju_dot3(u, a));
+  mju_normalize3(u);
+  mju_cross(l, a, u);
+  if ((s == 0 ? -l[1] : l[1]) < 0) mju_scl3(l, l, -1);  // lateral: -y right, +y left
+  mju_sub3(r, load->cop, k);
+  out->knee_grf_moment[s] = -ext[m->jnt_dofadr[knee]];
+  out->cop_lateral_knee[s] = mju_dot3(r, l);
+  out->knee_lateral_force[s] = mju_dot3(load->force, l);
+  out->knee_axial_force[s] = mju_dot3(load->force, u);
+  out->knee_lateral_tilt[s] = asin(l[2]);
 }
 
 void gs_balance_eval(const mjModel* m, mjData* d, const gsBalanceSpec* spec, const double* qacc,
@@ -66,7 +91,13 @@ void gs_balance_eval(const mjModel* m, mjData* d, const gsBalanceSpec* spec, con
     const double* hip = d->xanchor + 3 * spec->hip_joint[s];
     double side = s == 0 ? -1.0 : 1.0;  // lateral: -y right, +y left
     out->cop_lateral_hip[s] = out->cop_lateral_com[s] = NAN;
+    out->cop_foot_forward[s] = out->cop_foot_lateral[s] = NAN;
     if (!load[s].loaded) continue;
+    const double* xmat = d->xmat + 9 * spec->foot_body[s];
+    double rf[3], fwd[3] = {xmat[0], xmat[3], xmat[6]}, lat[3] = {xmat[2], xmat[5], xmat[8]};
+    mju_sub3(rf, load[s].cop, d->xpos + 3 * spec->foot_body[s]);
+    out->cop_foot_forward[s] = (fwd[0] < 0 ? -1 : 1) * mju_dot3(rf, fwd);
+    out->cop_foot_lateral[s] = (side * lat[1] < 0 ? -1 : 1) * mju_dot3(rf, lat);
     mj_applyFT(m, d, load[s].force, load[s].torque, load[s].cop, spec->foot_body[s], ext);
     double r[3], rxf[3];
     mju_sub3(r, load[s].cop, com);
@@ -75,6 +106,7 @@ void gs_balance_eval(const mjModel* m, mjData* d, const gsBalanceSpec* spec, con
     out->cop_lateral_hip[s] = side * (load[s].cop[1] - hip[1]);
     out->cop_lateral_com[s] = side * (load[s].cop[1] - com[1]);
   }
+  for (int s = 0; s < 2; s++) knee_frame(d, spec, s, &load[s], ext, m, out);
   mju_subFrom(tau, ext, m->nv);
   for (int s = 0; s < 2; s++) {
     out->hip_adduction_moment[s] = tau[m->jnt_dofadr[spec->hip_joint[s]]];

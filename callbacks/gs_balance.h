@@ -40,6 +40,7 @@ typedef struct gsBalanceSpec_ {
   int trunk_body;       // torso
   int lumbar_bending;   // joint lumbar_bending, -1 when absent
   int knee_adduction[2];  // right, left: joint knee_adduction(_l), -1 when absent (1-DOF knee)
+  int ankle_joint[2];     // right, left: ankle_angle(_l) (the shank's lower end), -1 when absent
 } gsBalanceSpec;
 
 // The balance at one instant (index 0 right, 1 left).
@@ -54,6 +55,27 @@ typedef struct gsBalance_ {
   double knee_adduction_moment[2];  // net moment about knee_adduction(_l) (N m, about the joint's
                                     // own axis), NAN without the joint: what the knee's contact,
                                     // ligaments and muscles supply together
+  // The ground reaction's part of knee_adduction_moment and its pieces in the knee's own frame
+  // (NAN without the joint, the ankle or a load): a, the knee_adduction axis; u, the shank's
+  // long axis (ankle centre to knee centre, made normal to a); l, the knee's lateral axis, normal
+  // to both and pointing away from the midline. With r = centre of pressure - knee centre (the
+  // joint's anchor) and F the foot's ground reaction:
+  //   knee_grf_moment = -(J^T [F; T])_knee = s (a . (r x F) + a . T),  s = +-1 the sign of the
+  //   net moment's convention, and a . (r x F) = +-(r_u F_l - r_l F_u)
+  // so the moment is the axial force F_u times the centre of pressure's lateral offset r_l, plus
+  // the force along the lateral axis F_l times the height r_u (about -0.5 m).
+  double knee_grf_moment[2];      // the ground reaction's part of the net moment (N m)
+  double cop_lateral_knee[2];     // r_l: centre of pressure lateral of the knee centre (m)
+  double knee_lateral_force[2];   // F_l: ground reaction along the knee's lateral axis (N)
+  double knee_axial_force[2];     // F_u: ground reaction along the shank, upward (N)
+  double knee_lateral_tilt[2];    // asin(l_z): the knee's lateral axis against the floor (rad;
+                                  // > 0 its lateral end up, as when the leg is abducted: the
+                                  // axial force then has a lateral part, F_l ~ F_u tilt)
+  // the centre of pressure in its foot's frame (the body of the foot's contact spheres: its
+  // origin; its x axis forward, z axis lateral, each signed to point so in the world), NAN
+  // unloaded (m)
+  double cop_foot_forward[2];
+  double cop_foot_lateral[2];
   double trunk_lateral;         // trunk's CoM minus the whole-body CoM along y (m, + left)
   double lumbar_bending;        // lumbar_bending (rad), NAN when absent
   double residual_force[3];     // tau of pelvis_tx, _ty, _tz (N; slide axes, world)

@@ -10,7 +10,14 @@
 //     lateral distances by delta with the side's sign;
 // (d) with only the pelvis translating, the angular momentum about the centre of mass is zero
 //     (1e-12), and the pelvis_tx residual is the total mass times its acceleration (1e-7);
-// (e) a model without the named joints is refused with the name in the reason.
+// (e) a model without the named joints is refused with the name in the reason;
+// (f) the ground reaction's part of the right knee's moment: the net moment less the gravity
+//     part (a static pose: M qdd + c = gravity) and, from MuJoCo's J^T, the cross product
+//     a . (r x F) about the knee_adduction axis through its anchor (1e-9 relative); its pieces:
+//     the centre of pressure moved 3 cm laterally lies 3 cm further lateral of the knee (to 1 %,
+//     the shank's small frontal tilt) and moves by its projections on the foot's axes (1e-12), the
+//     lateral axis level within 5 deg in the zero pose and
+//     tilting by -0.1 rad (to 0.01) when the hip adducts by 0.1 rad.
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -88,6 +95,36 @@ int main(void) {
   EXPECT_NEAR(delta, b2.cop_lateral_com[0], 1e-12);
   // the residual moment it leaves is W delta about the forward axis
   EXPECT_NEAR(W * delta, fabs(b2.grf_moment[0]), 1e-9 * W);
+
+  // (f) the ground reaction's part of the knee's moment
+  {
+    int kj = spec.knee_adduction[0];
+    const double* a = d->xaxis + 3 * kj;
+    double r[3], rxf[3];
+    mju_sub3(r, moved[0].cop, d->xanchor + 3 * kj);
+    mju_cross(rxf, r, moved[0].force);
+    EXPECT_REL(fabs(mju_dot3(a, rxf)), fabs(b2.knee_grf_moment[0]), 1e-9, 1e-9);
+    // the gravity part does not depend on where the load acts
+    EXPECT_REL(b.knee_adduction_moment[0] - b.knee_grf_moment[0],
+               b2.knee_adduction_moment[0] - b2.knee_grf_moment[0], 1e-9, 1e-9);
+    EXPECT_REL(delta, b2.cop_lateral_knee[0] - b.cop_lateral_knee[0], 0.01, 0);
+    EXPECT_NEAR(W, b.knee_axial_force[0], 0.02 * W);
+    EXPECT_TRUE(fabs(b.knee_lateral_tilt[0]) < 5 * M_PI / 180);
+    EXPECT_TRUE(isnan(b.knee_grf_moment[1]) && isnan(b.knee_lateral_tilt[1]));
+    // in the foot's frame: the move (0, -delta, 0) projected on its axes (calcn is turned out
+    // about 14 deg in the zero pose: most of it lateral, some of it backward)
+    const double* fm = d->xmat + 9 * spec.foot_body[0];
+    double lat_y = fm[5] < 0 ? fm[5] : -fm[5], fwd_y = fm[0] < 0 ? -fm[3] : fm[3];
+    EXPECT_NEAR(-delta * lat_y, b2.cop_foot_lateral[0] - b.cop_foot_lateral[0], 1e-12);
+    EXPECT_NEAR(-delta * fwd_y, b2.cop_foot_forward[0] - b.cop_foot_forward[0], 1e-12);
+    EXPECT_TRUE(-lat_y > 0.9);
+    EXPECT_TRUE(isnan(b.cop_foot_lateral[1]));
+    double tilt0 = b.knee_lateral_tilt[0];
+    set_joint(m, d, "hip_adduction", 0.1);
+    gs_balance_eval(m, d, &spec, zero, load, &b2);
+    EXPECT_NEAR(-0.1, b2.knee_lateral_tilt[0] - tilt0, 0.01);
+    set_joint(m, d, "hip_adduction", 0);
+  }
 
   // (d) the pelvis translating forward at 1.3 m/s, accelerating at 2 m/s^2, nothing loaded
   int tx = mj_name2id(m, mjOBJ_JOINT, "pelvis_tx");

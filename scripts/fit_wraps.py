@@ -458,13 +458,13 @@ def two_wrap_starts(model, mus, first_site, single, position):
     return out
 
 
-def nan_scan(args, frames, muscles):
-    """Count the poses where a muscle's MuJoCo length or moment arm is not finite: every
-    NAN_EVERY-th trial frame, each coordinate perturbed NAN_SAMPLES times by a normal deviate of
-    each scale in NAN_SCALES (rad; 1 % of that in m for translations), a fixed seed. Returns
-    (poses scanned, [(muscle, non-finite poses)])."""
+def nan_scan(probe, frames, muscles):
+    """Count the poses where a muscle's MuJoCo length or moment arm is not finite, on `probe`
+    (the model's, without fitting poses): every NAN_EVERY-th trial frame, each coordinate
+    perturbed NAN_SAMPLES times by a normal deviate of each scale in NAN_SCALES (rad; 1 % of
+    that in m for translations), a fixed seed. Returns (poses scanned, [(muscle, non-finite
+    poses)])."""
     rng = np.random.default_rng(0)
-    probe = Probe(args.probe, args.model, [])
     bad = {}
     scanned = 0
     for _, base in frames[::NAN_EVERY]:
@@ -480,7 +480,6 @@ def nan_scan(args, frames, muscles):
             n = int(np.sum(~np.isfinite(rows[:, :-1]).all(axis=1)))
             if n:
                 bad[mus["name"]] = bad.get(mus["name"], 0) + n
-    probe.close()
     return scanned, sorted(bad.items())
 
 
@@ -630,14 +629,15 @@ def main():
             previous = json.load(f)["muscles"]
     results, surrogate_error = {}, {}
     base_probe = Probe(args.probe, args.model, poses)
-    scan_probe = None if args.check else Probe(args.probe, args.model, [])
+    scan_probe = Probe(args.probe, args.model, [])  # the continuity scan's: no fitting poses
     worst = 0.0
     for mus in muscles:
         name = mus["name"]
         r = ref["muscles"][name]
         rows0 = base_probe.eval(name)
         e0 = errors(r, base_probe.joints, rows0)
-        surrogate_error[name] = float(np.max(np.abs(e0)))
+        e0_max = float(np.max(np.abs(e0)))
+        surrogate_error[name] = e0_max
         # a path site near a wrap surface (inside or out) makes the wrap hang on a rounding;
         # one deep inside is consistent (MuJoCo never wraps that segment)
         near = float(np.min(np.abs(rows0[:, -1])))
@@ -648,15 +648,15 @@ def main():
         tendon = [t for t in base.getroot().iter("spatial") if t.get("name") == name][0]
         slots = [k for k, el in enumerate(tendon) if el.get("geom")]
         print("%-10s %s: max |e| %.2f (objective %.3f), %d wrap geom(s)" % (
-            name, "model" if args.check else "converter surrogate", np.max(np.abs(e0)),
+            name, "model" if args.check else "converter surrogate", e0_max,
             objective_of(e0), len(slots)), flush=True)
         if args.check:
-            worst = max(worst, float(np.max(np.abs(e0))))
+            worst = max(worst, e0_max)
             continue
         if len(slots) != 1:
             continue
         flawed = False
-        if np.max(np.abs(e0)) <= args.keep:
+        if e0_max <= args.keep:
             # the surrogate stays if it is also clear of its wrap and continuous; else it is
             # fitted like any other and replaced by a fit within --keep (glmax1's converter
             # surrogate had its path site 0.1 mm from the cylinder, and its length jumped
@@ -684,9 +684,8 @@ def main():
                              two_wrap_starts(model, mus, first_site, best[2], position))
             if two is not None and (two[1], two[0]) < (best[1], best[0]):
                 best = two
-        if best is not None and (best[1] < np.max(np.abs(e0)) or
-                                 (flawed and best[1] <= args.keep)):
-            keep_fit(results, name, best, slot, float(np.max(np.abs(e0))))
+        if best is not None and (best[1] < e0_max or (flawed and best[1] <= args.keep)):
+            keep_fit(results, name, best, slot, e0_max)
             write_out(args, idx, trial, results)
     # second pass: a muscle still above the tolerance starts from the fit of a muscle that wraps
     # over the same OpenSim objects (the other head of a pair), as is and mirrored medio-laterally
@@ -723,26 +722,24 @@ def main():
             results[name] = kept
             write_out(args, idx, trial, results)
     base_probe.close()
-    if scan_probe is not None:
-        scan_probe.close()
     if args.check:
         print("%s: largest max |e| %.2f over %d muscles and %d poses (1 = the tolerance)" % (
             args.model, worst, len(muscles), len(idx)))
-        scanned, bad = nan_scan(args, frames, muscles)
+        scanned, bad = nan_scan(scan_probe, frames, muscles)
         print("%s: NaN scan: %d poses (one trial frame in %d, perturbed by %s rad, 1 %% of that "
               "in m), non-finite lengths or moment arms: %s" % (
                   args.model, scanned, NAN_EVERY, " / ".join("%g" % v for v in NAN_SCALES),
                   ", ".join("%s %d" % b for b in bad) or "none"))
-        probe = Probe(args.probe, args.model, [])
-        jumps = [(mus["name"], largest_jump(probe, mus["name"], args.jump_lines))
+        jumps = [(mus["name"], largest_jump(scan_probe, mus["name"], args.jump_lines))
                  for mus in muscles]
-        probe.close()
+        scan_probe.close()
         jumped = ["%s %.2f mm" % (n, 1000 * j) for n, j in jumps if j > JUMP_TOL]
         print("%s: continuity scan: %d lines of %d poses (from one trial frame in %d, %g rad), "
               "largest length step %.3f mm; jumps above %.1f mm: %s" % (
                   args.model, len(args.jump_lines), JUMP_STEPS, NAN_EVERY, JUMP_SCALE,
                   1000 * max(j for _, j in jumps), 1000 * JUMP_TOL, ", ".join(jumped) or "none"))
         sys.exit(1 if worst > 1.0 or bad or jumped else 0)
+    scan_probe.close()
     write_out(args, idx, trial, results)
 
 

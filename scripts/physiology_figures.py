@@ -10,7 +10,14 @@ RESULTS (default results) is the folder `gaitsim run` writes. Prints:
     stance;
   - for each RESULTS/sweep/predict_*: the stride-mean metabolic power by muscle group
     (metabolics.sto, trapezoid over the nodes; W/kg, and J/(kg m) at the prediction's speed),
-    and the mean lumbar_extension (deg).
+    and the mean lumbar_extension (deg), and what its muscles spend while slack: the stride-mean
+    power of every muscle at the node intervals where its tendon force (muscle_forces.sto) is
+    below 1 % of its Fmax, above Umberger's 1 W/kg floor (Fmax and mass from the `user` rows of
+    the model summary.json names; W, and W/kg of body mass), the five largest by name;
+  - over three predictions or more, each group's power in Ralston's form a + b v^2 (least
+    squares; W/kg, v in m/s): a, the cost per second whatever the speed, which makes the cost of
+    transport fall with speed, and b; beside Ralston 1958's muscle share (his gross rate less the
+    basal 1.2 W/kg that scripts/validation.py adds).
 With --gaitsim (the built binary), also, for the tracking solution and each prediction: what the
 trunk muscles (ercspn, intobl, extobl) carry about each lumbar coordinate at 20 instants of the
 stride (`GAITSIM inspect MODEL --pose DIR/states.sto --time t`, MODEL from summary.json): their
@@ -25,9 +32,11 @@ import glob
 import os
 import re
 import sys
+import xml.etree.ElementTree as ET
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from gs_scriptlib import PrepError, inspect_muscles, read_json, read_storage  # noqa: E402
+from validation import BASAL_W_PER_KG, fit_ralston_form, ralston_gross_w_per_kg  # noqa: E402
 
 COORDINATES = ["pelvis_tz", "pelvis_rx", "hip_adduction", "hip_adduction_l", "knee_adduction",
                "subtalar_angle", "subtalar_angle_l", "lumbar_extension", "lumbar_bending"]
@@ -97,6 +106,66 @@ def prediction(folder):
     for name, _ in GROUPS:
         print(f"  {name:18s} {power[name]:6.3f} W/kg  {power[name] / speed:6.3f} J/(kg m)  "
               f"{100 * power[name] / total:5.1f} %")
+    slack_cost(folder, mass)
+    return speed, power, total
+
+
+def speed_fit(rows):
+    """Each group's power across the predictions rows = [(speed, power by group, total)] in
+    Ralston's form a + b v^2, beside Ralston's muscle share."""
+    v = [r[0] for r in rows]
+    print(f"power by speed in Ralston's form a + b v^2 over {len(rows)} predictions (W/kg): "
+          "a, b, and a / v at the slowest and fastest speed (J/(kg m))")
+    fits = [(name, fit_ralston_form(v, [r[1][name] for r in rows])) for name, _ in GROUPS]
+    fits.append(("muscles", fit_ralston_form(v, [r[2] for r in rows])))
+    a_r = ralston_gross_w_per_kg(0.0) - BASAL_W_PER_KG
+    b_r = ralston_gross_w_per_kg(1.0) - ralston_gross_w_per_kg(0.0)
+    fits.append((f"Ralston less {BASAL_W_PER_KG}", (a_r, b_r)))
+    for name, (a, b) in fits:
+        print(f"  {name:18s} a {a:+6.3f}  b {b:+6.3f}  a/v {a / min(v):6.3f} .. {a / max(v):6.3f}")
+
+
+SLACK_FORCE = 0.01      # a muscle is slack below this fraction of its Fmax (tendon force)
+FLOOR_W_PER_KG = 1.0    # Umberger's minimum heat rate per kg of muscle (gs_metabolics.h)
+
+
+def muscle_params(model):
+    """{muscle: (Fmax N, mass kg)} from the MJCF `user` rows (gs_model_layout.h: 0 and 7)."""
+    try:
+        root = ET.parse(model).getroot()
+    except (OSError, ET.ParseError) as e:
+        raise PrepError(model, f"cannot read the model ({e})")
+    out = {}
+    for m in root.iter("muscle"):
+        u = [float(x) for x in m.get("user", "").split()]
+        if len(u) >= 8 and u[0] > 0:
+            out[m.get("name")] = (u[0], u[7])
+    return out
+
+
+def slack_cost(folder, mass):
+    """Stride-mean power (W) of the muscles while slack, above the floor: total and by muscle."""
+    s = read_json(os.path.join(folder, "summary.json"))
+    if not s.get("model"):
+        raise PrepError(os.path.join(folder, "summary.json"), "no model")
+    prm = muscle_params(s["model"])
+    met = columns(os.path.join(folder, "metabolics.sto"))
+    force = columns(os.path.join(folder, "muscle_forces.sto"))
+    t = met["time"]
+    by = {}
+    for name, (fmax, mmass) in prm.items():
+        if name not in met or name not in force:
+            continue
+        e, f = met[name], force[name]
+        area = sum((0.5 * (e[k] + e[k - 1]) - FLOOR_W_PER_KG * mmass) * (t[k] - t[k - 1])
+                   for k in range(1, len(t))
+                   if 0.5 * (f[k] + f[k - 1]) < SLACK_FORCE * fmax)
+        by[name] = max(area, 0.0) / (t[-1] - t[0])
+    total = sum(by.values())
+    top = sorted(by.items(), key=lambda x: -x[1])[:5]
+    print(f"  slack muscles (tendon force < {100 * SLACK_FORCE:g} % Fmax), above the "
+          f"{FLOOR_W_PER_KG:g} W/kg floor: {total:.1f} W ({total / mass:.3f} W/kg); "
+          + ", ".join(f"{n} {w:.1f}" for n, w in top))
 
 
 TRUNK = dict(GROUPS)["trunk"]
@@ -152,8 +221,10 @@ def main(argv):
         return 2
     try:
         tracking(os.path.join(results, "track"))
-        for folder in sorted(glob.glob(os.path.join(results, "sweep", "predict_*"))):
-            prediction(folder)
+        rows = [prediction(folder)
+                for folder in sorted(glob.glob(os.path.join(results, "sweep", "predict_*")))]
+        if len(rows) >= 3:
+            speed_fit(rows)
         if gaitsim:
             for folder in [os.path.join(results, "track")] + \
                     sorted(glob.glob(os.path.join(results, "sweep", "predict_*"))):

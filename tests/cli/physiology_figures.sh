@@ -3,11 +3,16 @@
 # hip_adduction is the trial's minus 5 deg at every node (mean -5.000, RMS 5.000; the model's
 # mean +1.00 against the measured +6.00 over the nodes), and a prediction at 2.0 m/s of a 1000 N
 # (101.94 kg) body whose erector spinae spend 300 W and vasti 100 W throughout (trunk 2.943
-# W/kg, 1.472 J/(kg m), 75 % of 3.924 W/kg; vasti 0.981 W/kg, 0.490 J/(kg m)); with --gaitsim
+# W/kg, 1.472 J/(kg m), 75 % of 3.924 W/kg; vasti 0.981 W/kg, 0.490 J/(kg m)), the vasti slack
+# (5 N, below 1 % of their 1000 N) and 0.2 kg (floor 0.2 W: 99.8 W, 0.979 W/kg, spent while
+# slack), the erector spinae at 500 N (not slack; the model m.xml's user rows); with --gaitsim
 # a stand-in binary whose `inspect` rows give ercspn_r 100 N (arms 0.04 extension, 0.03
 # bending; 10 W) and extobl_r 50 N (-0.06, 0.02; 5 W) and vasint 500 N (knee only) at every
 # instant: trunk 15.0 W, extension net |4 - 3| = 1.0 and summed 7.0 N m, bending 4.0 and 4.0,
-# rotation 0; a missing states.sto exits 1 with one line naming it.
+# rotation 0; with two more predictions at 1.0 and 1.5 m/s (erector spinae 300 W, vasti 25 v^2 W)
+# the fit a + b v^2 gives the trunk a = 2.943, b = 0 W/kg (a / v 2.943 .. 1.471 J/(kg m)), the
+# vasti a = 0, b = 0.245, the muscles a = 2.943, b = 0.245, beside Ralston's 0.822 + 1.331 v^2
+# less the basal 1.2 W/kg; a missing states.sto exits 1 with one line naming it.
 # usage: physiology_figures.sh GAITSIM SOURCE_DIR
 set -u
 src=$2
@@ -28,6 +33,13 @@ json.dump({"trial": "trial", "model": "m.xml", "stride_time_s": 1.0},
 sto("results/sweep/predict_2/metabolics.sto", ["time", "ercspn_r", "vasint", "total"],
     [[0.25 * k, 300.0, 100.0, 400.0] for k in range(5)])
 sto("results/sweep/predict_2/states.sto", ["time", "lumbar_extension"], [[0, -15.0], [1, -17.0]])
+sto("results/sweep/predict_2/muscle_forces.sto", ["time", "ercspn_r", "vasint"],
+    [[0.25 * k, 500.0, 5.0] for k in range(5)])
+with open("m.xml", "w") as f:
+    f.write('<mujoco><actuator>'
+            '<muscle name="ercspn_r" user="2500 0.115 0.03 0 10 0.6 250000 1.22 0 0.01 0.04 35"/>'
+            '<muscle name="vasint" user="1000 0.099 0.24 0.08 10 0.5 552630 0.2 1 0.01 0.04 35"/>'
+            '</actuator></mujoco>')
 json.dump({"body_weight_n": 1000.0, "speed_target_mps": 2.0, "model": "m.xml",
            "stride_time_s": 1.0},
           open("results/sweep/predict_2/summary.json", "w"))
@@ -40,6 +52,30 @@ line="results/sweep/predict_2: 2.0 m/s, muscles 3.92 W/kg (1.96 J/(kg m)), lumba
 check "muscles 3.92 W/kg, lumbar -16.0" grep -qF "$line mean -16.0 deg" <<<"$out"
 check "trunk 75 %" grep -qE "^  trunk +2\.943 W/kg +1\.472 J/\(kg m\) +75\.0 %$" <<<"$out"
 check "vasti 25 %" grep -qE "^  vasti +0\.981 W/kg +0\.490 J/\(kg m\) +25\.0 %$" <<<"$out"
+check "slack: vasint 99.8 W above its 0.2 W floor" grep -qF \
+  "  slack muscles (tendon force < 1 % Fmax), above the 1 W/kg floor: 99.8 W (0.979 W/kg); vasint 99.8, ercspn_r 0.0" <<<"$out"
+check "one prediction: no fit" test "$(grep -c "Ralston's form" <<<"$out")" -eq 0
+
+/usr/bin/python3 - <<'PY'
+import json, os, shutil
+for v in (1.0, 1.5):
+    d = f"results/sweep/predict_{v:g}"
+    shutil.copytree("results/sweep/predict_2", d)
+    with open(f"{d}/metabolics.sto", "w") as f:
+        f.write("x\nendheader\ntime\tercspn_r\tvasint\ttotal\n")
+        f.writelines(f"{0.25 * k}\t300.0\t{25 * v * v}\t{300 + 25 * v * v}\n" for k in range(5))
+    s = json.load(open(f"{d}/summary.json"))
+    s["speed_target_mps"] = v
+    json.dump(s, open(f"{d}/summary.json", "w"))
+PY
+out=$(/usr/bin/python3 "$src/scripts/physiology_figures.py" results)
+check "fit: three predictions" grep -qF "Ralston's form a + b v^2 over 3 predictions" <<<"$out"
+check "fit: trunk a 2.943, b 0" \
+  grep -qE "^  trunk +a \+2\.943  b [+-]0\.000  a/v  2\.943 \.\.  1\.471$" <<<"$out"
+check "fit: vasti a 0, b 0.245" grep -qE "^  vasti +a [+-]0\.000  b \+0\.245  a/v " <<<"$out"
+check "fit: muscles a 2.943, b 0.245" grep -qE "^  muscles +a \+2\.943  b \+0\.245 " <<<"$out"
+check "fit: Ralston less 1.2" grep -qE "^  Ralston less 1\.2 +a \+0\.822  b \+1\.331 " <<<"$out"
+rm -r results/sweep/predict_1 results/sweep/predict_1.5
 
 cat >fake_gaitsim <<'SH'
 #!/usr/bin/env bash

@@ -133,11 +133,16 @@ def muscle_params(model):
     """{muscle: (Fmax N, mass kg)} from the MJCF `user` rows (gs_model_layout.h: 0 and 7)."""
     try:
         root = ET.parse(model).getroot()
-    except (OSError, ET.ParseError) as e:
-        raise PrepError(model, f"cannot read the model ({e})")
+    except OSError as e:
+        raise PrepError(model, f"cannot read the model ({e.strerror})")
+    except ET.ParseError as e:
+        raise PrepError(model, f"not an MJCF file ({e})")
     out = {}
     for m in root.iter("muscle"):
-        u = [float(x) for x in m.get("user", "").split()]
+        try:
+            u = [float(x) for x in m.get("user", "").split()]
+        except ValueError:
+            raise PrepError(model, f"muscle {m.get('name')}: a user value is not a number")
         if len(u) >= 8 and u[0] > 0:
             out[m.get("name")] = (u[0], u[7])
     return out

@@ -12,7 +12,8 @@
 # rotation 0; with two more predictions at 1.0 and 1.5 m/s (erector spinae 300 W, vasti 25 v^2 W)
 # the fit a + b v^2 gives the trunk a = 2.943, b = 0 W/kg (a / v 2.943 .. 1.471 J/(kg m)), the
 # vasti a = 0, b = 0.245, the muscles a = 2.943, b = 0.245, beside Ralston's 0.822 + 1.331 v^2
-# less the basal 1.2 W/kg; a missing states.sto exits 1 with one line naming it.
+# less the basal 1.2 W/kg; a missing states.sto, a missing model or a model whose user row is
+# not numbers exits 1 with one line naming the file.
 # usage: physiology_figures.sh GAITSIM SOURCE_DIR
 set -u
 src=$2
@@ -94,6 +95,19 @@ check "--gaitsim: trunk 15.0 W" grep -qF "results/sweep/predict_2: trunk muscles
 check "--gaitsim: extension 1.0 / 7.0" grep -qE "^  lumbar_extension +1\.0 +7\.0$" <<<"$out"
 check "--gaitsim: bending 4.0 / 4.0" grep -qE "^  lumbar_bending +4\.0 +4\.0$" <<<"$out"
 check "--gaitsim: rotation 0" grep -qE "^  lumbar_rotation +0\.0 +0\.0$" <<<"$out"
+
+cp m.xml m.good
+printf '<mujoco><actuator><muscle name="vasint" user="1000 x"/></actuator></mujoco>' >m.xml
+err=$(/usr/bin/python3 "$src/scripts/physiology_figures.py" results 2>&1 >/dev/null)
+status=$?
+check "bad user row: exit 1 (got $status)" test "$status" -eq 1
+check "bad user row: one line naming the model" \
+  test "$err" = "physiology_figures: m.xml: muscle vasint: a user value is not a number"
+rm m.xml
+err=$(/usr/bin/python3 "$src/scripts/physiology_figures.py" results 2>&1 >/dev/null)
+check "missing model: one line naming it" \
+  test "$err" = "physiology_figures: m.xml: cannot read the model (No such file or directory)"
+mv m.good m.xml
 
 rm results/track/states.sto
 err=$(/usr/bin/python3 "$src/scripts/physiology_figures.py" results 2>&1 >/dev/null)

@@ -106,7 +106,9 @@ def prediction(folder):
     for name, _ in GROUPS:
         print(f"  {name:18s} {power[name]:6.3f} W/kg  {power[name] / speed:6.3f} J/(kg m)  "
               f"{100 * power[name] / total:5.1f} %")
-    slack_cost(folder, mass)
+    if not s.get("model"):
+        raise PrepError(os.path.join(folder, "summary.json"), "no model")
+    slack_cost(s["model"], met, columns(os.path.join(folder, "muscle_forces.sto")), mass)
     return speed, power, total
 
 
@@ -148,14 +150,10 @@ def muscle_params(model):
     return out
 
 
-def slack_cost(folder, mass):
-    """Stride-mean power (W) of the muscles while slack, above the floor: total and by muscle."""
-    s = read_json(os.path.join(folder, "summary.json"))
-    if not s.get("model"):
-        raise PrepError(os.path.join(folder, "summary.json"), "no model")
-    prm = muscle_params(s["model"])
-    met = columns(os.path.join(folder, "metabolics.sto"))
-    force = columns(os.path.join(folder, "muscle_forces.sto"))
+def slack_cost(model, met, force, mass):
+    """Stride-mean power (W) of the muscles of `model` while slack, above the floor, from a
+    prediction's metabolics.sto and muscle_forces.sto columns: total and by muscle."""
+    prm = muscle_params(model)
     t = met["time"]
     by = {}
     for name, (fmax, mmass) in prm.items():
@@ -226,13 +224,12 @@ def main(argv):
         return 2
     try:
         tracking(os.path.join(results, "track"))
-        rows = [prediction(folder)
-                for folder in sorted(glob.glob(os.path.join(results, "sweep", "predict_*")))]
+        predictions = sorted(glob.glob(os.path.join(results, "sweep", "predict_*")))
+        rows = [prediction(folder) for folder in predictions]
         if len(rows) >= 3:
             speed_fit(rows)
         if gaitsim:
-            for folder in [os.path.join(results, "track")] + \
-                    sorted(glob.glob(os.path.join(results, "sweep", "predict_*"))):
+            for folder in [os.path.join(results, "track")] + predictions:
                 trunk_moments(gaitsim, folder)
     except PrepError as e:
         print(f"physiology_figures: {e}", file=sys.stderr)

@@ -5,6 +5,9 @@
 //   2. restarts: after a fall-back (GO_SOLVE_FELL_BACK: Ipopt came near a solution, violation
 //      <= fallback_viol, and left it), again from the best iterate with the iterations and time
 //      left, a small barrier and the point barely pushed off its bounds; at most max_restarts;
+//      and after the main solve stopped by the settled rule (GO_SOLVE_SETTLED), from its best
+//      iterate with a fresh L-BFGS memory (a new Ipopt solve), barrier 1e-7 and the point pushed
+//      1e-10 off its bounds, at most settle_restarts times;
 //   3. refinement: an L-BFGS or Gauss-Newton main solve that stopped short (not converged, not
 //      interrupted; with handover_iter, at its first nearly feasible iterate from that iteration
 //      on) is
@@ -85,6 +88,9 @@ typedef struct {
                               // refine_wall_s), the polish gets it whole
   int max_restarts;           // restarts after a fall-back, at most (-; GO_MAX_RESTARTS at
                               // most, the size of go_solve_report.restarts)
+  int settle_restarts;        // restarts after the main solve (or a restart) settled, at most
+                              // (-; GO_MAX_SETTLE_RESTARTS at most); 0: none (the default;
+                              // gaitsim predict: GO_SETTLE_RESTARTS)
   int refine_iter;            // refinement's Newton iterations at most (-); 0: no refinement
   int handover_iter;          // > 0 with a refinement after an L-BFGS main solve: that solve
                               // hands over to the refinement at its first iterate from this
@@ -109,8 +115,9 @@ typedef struct {
                               // start); NULL: from go_solve_run's start
 } go_solve_plan;
 
-// one restart after a fall-back (summary.json "restarts")
+// one restart after a fall-back or a settled solve (summary.json "restarts")
 typedef struct {
+  int after_settled;      // 1: the solve before it settled (GO_SOLVE_SETTLED); 0: it fell back
   int after_iterations;   // iterations done when the solve fell back (-)
   int from_iteration;     // the best iterate it restarted from (-)
   double objective;       // physical objective J there (-)
@@ -125,7 +132,7 @@ typedef struct {
                               // the last of them
   int converged;              // 1: result reached Ipopt's optimal or acceptable level
   int n_restarts;             // restarts done (-)
-  go_solve_restart restarts[GO_MAX_RESTARTS];  // in order (n_restarts)
+  go_solve_restart restarts[GO_MAX_RESTARTS + GO_MAX_SETTLE_RESTARTS];  // in order (n_restarts)
   int refined;                // -1: no refinement run, 0: run and not used, 1: used
   go_solve_result refine;     // the refinement (refined >= 0): its Newton solve, iterations
                               // and times including its Gauss-Newton phase

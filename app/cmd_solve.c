@@ -935,8 +935,9 @@ static const char* kPredictUsageSolver =
     "                      best iterate (at most " GO_STR(GO_MAX_RESTARTS) " times; summary.json "
     "restarts); default " GO_STR(GO_FALLBACK_RISE) ",\n"
     "                      0 turns the guard off\n"
-    "  --settle-restarts N once the objective has settled, restart from the best iterate with a\n"
-    "                      fresh quasi-Newton memory and a small barrier, up to N times in all\n"
+    "  --settle-restarts N once the objective has settled, restart with a fresh quasi-Newton\n"
+    "                      memory from the best iterate projected onto the dynamics (as the\n"
+    "                      polish projects), up to N times in all\n"
     "                      (0-" GO_STR(GO_MAX_SETTLE_RESTARTS) "; default " GO_STR(GO_SETTLE_RESTARTS)
     ": L-BFGS settles where its memory has gone stale,\n"
     "                      and a restart went 4-8 % lower; summary.json restarts, \"after\":\n"

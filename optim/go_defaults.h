@@ -101,9 +101,9 @@
 #define GO_PREDICT_SETTLE_REL 1e-5
 // a prediction's restarts after its main solve settled (go_solve_plan.settle_restarts, -): L-BFGS
 // settles where its quasi-Newton memory has gone stale, not at the minimum. Restarted from its
-// own solution with a fresh memory and a small barrier, the main job's 0.8 and 2.0 m/s
+// own polished solution with a fresh memory and a small barrier, the main job's 0.8 and 2.0 m/s
 // predictions went 3.7 % and 8.4 % lower (371 and 630 iterations more); a second restart gained
-// 0.01 % (docs/BENCHMARKS.md, "The sweep's predictions stop above their minimum").
+// 0.01 % (docs/BENCHMARKS.md, "Predictions restart once after settling").
 // GO_MAX_SETTLE_RESTARTS is the most `predict --settle-restarts` takes
 #define GO_SETTLE_RESTARTS 1
 #define GO_MAX_SETTLE_RESTARTS 3

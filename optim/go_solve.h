@@ -5,9 +5,10 @@
 //   2. restarts: after a fall-back (GO_SOLVE_FELL_BACK: Ipopt came near a solution, violation
 //      <= fallback_viol, and left it), again from the best iterate with the iterations and time
 //      left, a small barrier and the point barely pushed off its bounds; at most max_restarts;
-//      and after the main solve stopped by the settled rule (GO_SOLVE_SETTLED), from its best
-//      iterate with a fresh L-BFGS memory (a new Ipopt solve), barrier 1e-7 and the point pushed
-//      1e-10 off its bounds, at most settle_restarts times;
+//      and after the main solve stopped by the settled rule (GO_SOLVE_SETTLED), with a fresh
+//      L-BFGS memory (a new Ipopt solve) from its best iterate projected onto the dynamics (as
+//      the polish of stage 5 projects), with the same small barrier, at most settle_restarts
+//      times;
 //   3. refinement: an L-BFGS or Gauss-Newton main solve that stopped short (not converged, not
 //      interrupted; with handover_iter, at its first nearly feasible iterate from that iteration
 //      on) is

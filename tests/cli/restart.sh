@@ -15,13 +15,13 @@
 # third solve fell back too), 0 with a converged status; --fallback-rise with a negative value is
 # a usage error (exit 2).
 # Then the restart after a settled solve, by default (--settle-restarts 1): measured, the
-# prediction settles after 179 iterations, restarts from its best iterate (164, J 1.09545) with a
-# fresh L-BFGS memory, that restart falls back after 7 and the fall-back's restart settles at 277,
-# J 1.09531. Expected: the first restart marked "settled", after as many iterations as the
+# prediction settles after 179 iterations, restarts with a fresh L-BFGS memory from its best
+# iterate (164, J 1.09545, violation 4e-4) projected onto the dynamics, and settles again after
+# 270 iterations in all, J 1.09531 polished. Expected: the first restart marked "settled", after as many iterations as the
 # progress line names, from an iterate no later than that, the solve going on past it, at most one
 # "settled" restart, every fall-back entry marked "fell back", a final objective no higher than the
-# one it restarted from (the restart's best iterate is at least its start; the polish moves J by
-# less than 1e-3 relative here), exit 0 with a converged status; --settle-restarts above
+# one it restarted from by more than 1e-3 relative (the restart's best iterate is at least its
+# projected start by the ranking; the projection moves J by less than that here), exit 0 with a converged status; --settle-restarts above
 # GO_MAX_SETTLE_RESTARTS (3) is a usage error (exit 2).
 # usage: restart.sh GAITSIM SOURCE_DIR
 set -u

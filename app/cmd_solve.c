@@ -926,22 +926,13 @@ static const char* kPredictUsage =
     "  --jacobian forward|central  finite differences of the path rows in the main solve:\n"
     "                      forward (half the model evaluations per Jacobian) or central\n"
     "                      (default " GO_PREDICT_JACOBIAN_NAME "; the polish uses central ones)\n"
-    "  --no-polish         no feasibility polish of a solve that stopped short\n";
-// (in two parts: C11 compilers need not take string literals over 4095 characters)
-static const char* kPredictUsageSolver =
+    "  --no-polish         no feasibility polish of a solve that stopped short\n"
     "  --fallback-rise F   stop when the objective rises by more than the fraction F above the\n"
     "                      lowest one reached at a violation <= " GO_STR(GO_FALLBACK_VIOL)
     ", and restart from the\n"
     "                      best iterate (at most " GO_STR(GO_MAX_RESTARTS) " times; summary.json "
     "restarts); default " GO_STR(GO_FALLBACK_RISE) ",\n"
     "                      0 turns the guard off\n"
-    "  --settle-restarts N once the objective has settled, restart with a fresh quasi-Newton\n"
-    "                      memory from the best iterate projected onto the dynamics (as the\n"
-    "                      polish projects), up to N times in all\n"
-    "                      (0-" GO_STR(GO_MAX_SETTLE_RESTARTS) "; default " GO_STR(GO_SETTLE_RESTARTS)
-    ": L-BFGS settles where its memory has gone stale,\n"
-    "                      and a restart went 4-8 % lower; summary.json restarts, \"after\":\n"
-    "                      \"settled\"); within --max-iter\n"
     "  --ipopt KEY=VALUE   extra Ipopt option (repeatable)\n";
 
 int gs_cmd_predict(int argc, char** argv) {
@@ -958,8 +949,7 @@ int gs_cmd_predict(int argc, char** argv) {
       {"min-vgrf", required_argument, NULL, 'W'},
       {"stride-time", required_argument, NULL, 'D'},
       {"stride-time-start", required_argument, NULL, 'E'},
-      {"jacobian", required_argument, NULL, 'J'},
-      {"settle-restarts", required_argument, NULL, 'K'},      {NULL, 0, NULL, 0}};
+      {"jacobian", required_argument, NULL, 'J'},             {NULL, 0, NULL, 0}};
   gsTrackOptions o;
   defaults(&o);
   o.predict = 1;
@@ -969,7 +959,6 @@ int gs_cmd_predict(int argc, char** argv) {
                            // "Predictions: the metabolic Hessian and Newton")
   o.plan.max_iter = GO_MAX_ITER;
   go_solve_plan_settle_main(&o.plan, GO_PREDICT_SETTLE_VIOL, GO_PREDICT_SETTLE_REL);
-  o.plan.settle_restarts = GO_SETTLE_RESTARTS;
   o.plan.main_jacobian = GO_PREDICT_FORWARD_JACOBIAN ? GO_JAC_SPARSE_FORWARD : GO_JAC_SPARSE;
   o.nodes = GO_NODES_PREDICT;
   o.w_effort = GO_PREDICT_W_EFFORT;
@@ -981,7 +970,7 @@ int gs_cmd_predict(int argc, char** argv) {
   opterr = 0;
   int c, bad = 0, model_given = 0, nodes_given = 0;
   char err[256];
-  while (!bad && (c = getopt_long(argc, argv, ":g:s:o:m:n:t:i:T:w:PFS:R:W:D:E:J:K:p:h", options,
+  while (!bad && (c = getopt_long(argc, argv, ":g:s:o:m:n:t:i:T:w:PFS:R:W:D:E:J:p:h", options,
                                   NULL)) != -1) {
     switch (c) {
       case 'g': o.guess = optarg; break;
@@ -1002,10 +991,6 @@ int gs_cmd_predict(int argc, char** argv) {
         break;
       case 'w': bad = parse_weight(optarg, &o); break;
       case 'P': o.plan.polish = 0; break;
-      case 'K':
-        bad = gs_opt_int("--settle-restarts", optarg, 0, GO_MAX_SETTLE_RESTARTS,
-                         &o.plan.settle_restarts);
-        break;
       case 'F': o.fibre_bounds = 0; break;
       case 'D': bad = gs_opt_real("--stride-time", optarg, 0.4, 2.5, 0, &o.stride_time); break;
       case 'E':
@@ -1034,10 +1019,7 @@ int gs_cmd_predict(int argc, char** argv) {
           bad = 1;
         }
         break;
-      case 'h':
-        fputs(kPredictUsage, stdout);
-        fputs(kPredictUsageSolver, stdout);
-        return GS_EXIT_OK;
+      case 'h': fputs(kPredictUsage, stdout); return GS_EXIT_OK;
       default: return gs_opt_getopt_error("predict", c, argv);
     }
   }
@@ -1206,11 +1188,9 @@ static int solve(gsTrackOptions o) {
   }
   cJSON_AddStringToObject(summary, "status", go_solve_status_str(res->status));
   cJSON_AddNumberToObject(summary, "iterations", res->iterations);
-  // after fall-backs and settled solves, in order
-  cJSON* restarts = cJSON_AddArrayToObject(summary, "restarts");
+  cJSON* restarts = cJSON_AddArrayToObject(summary, "restarts");  // after fall-backs, in order
   for (int r = 0; r < rep.n_restarts; r++) {
     cJSON* rj = cJSON_CreateObject();
-    cJSON_AddStringToObject(rj, "after", rep.restarts[r].after_settled ? "settled" : "fell back");
     cJSON_AddNumberToObject(rj, "after_iterations", rep.restarts[r].after_iterations);
     cJSON_AddNumberToObject(rj, "from_iteration", rep.restarts[r].from_iteration);
     cJSON_AddNumberToObject(rj, "objective", rep.restarts[r].objective);

@@ -62,7 +62,6 @@ static const optRule kRules[] = {
     {"stride-time", KIND_PREDICT, OPT_NUM, 0.4, 2.5, 0, NULL},
     {"stride-time-start", KIND_PREDICT, OPT_NUM, 0.4, 2.5, 0, NULL},
     {"jacobian", KIND_PREDICT, OPT_ENUM, 0, 0, 0, "forward|central"},
-    {"settle-restarts", KIND_PREDICT, OPT_INT, 0, GO_MAX_SETTLE_RESTARTS, 0, NULL},
 };
 #define NRULES ((int)(sizeof(kRules) / sizeof(kRules[0])))
 

@@ -99,14 +99,6 @@
 // factorisation per L-BFGS iteration, and the settled rule")
 #define GO_PREDICT_SETTLE_VIOL 1e-4
 #define GO_PREDICT_SETTLE_REL 1e-5
-// a prediction's restarts after its main solve settled (go_solve_plan.settle_restarts, -): L-BFGS
-// settles where its quasi-Newton memory has gone stale, not at the minimum. Restarted from its
-// own polished solution with a fresh memory and a small barrier, the main job's 0.8 and 2.0 m/s
-// predictions went 3.7 % and 8.4 % lower (371 and 630 iterations more); a second restart gained
-// 0.01 % (docs/BENCHMARKS.md, "Predictions restart once after settling").
-// GO_MAX_SETTLE_RESTARTS is the most `predict --settle-restarts` takes
-#define GO_SETTLE_RESTARTS 1
-#define GO_MAX_SETTLE_RESTARTS 3
 // a prediction's main solve differentiates the path rows by central differences (0), not
 // forward ones (GO_JAC_SPARSE_FORWARD; 1, `predict --jacobian forward`): forward differences
 // make an 80-node iteration a third cheaper, but the 2.0 m/s prediction then went into a basin

@@ -227,77 +227,27 @@ typedef struct {
   go_hess* hess;            // Hessian of the main solve or of the refinement, or NULL
 } run_state;
 
-// The dynamically consistent point nearest to zfrom (n, physical): Ipopt with set_polish's
-// options on the problem with a proximal goal at zfrom (go_gait_set_proximal, Gauss-Newton
-// Hessian), at most max_iter iterations and max_wall_s seconds (<= 0: none), from zfrom. Writes
-// the point it reached (Ipopt's when it converged, else its best iterate) to zto (n; may be
-// zfrom) with its violation to *viol, the solve's figures to res; 0, or -1 with err. Uses s->z
-// and s->zs.
-static int project_onto_dynamics(run_state* s, const double* zfrom, double* zto, int max_iter,
-                                 double max_wall_s, go_solve_result* res, double* viol,
-                                 char* err, int errsz) {
-  const go_solve_plan* p = s->p;
-  if (go_gait_set_proximal(s->g, zfrom) != 0) {
-    snprintf(err, (size_t)errsz, "out of memory");
-    return -1;
-  }
-  if (s->z != zfrom) memcpy(s->z, zfrom, sizeof(double) * (size_t)s->n);
-  go_ipopt_opts po;
-  if (set_polish(&po, err, errsz) != 0) {
-    go_gait_set_proximal(s->g, NULL);
-    return -1;
-  }
-  po.max_iter = max_iter;
-  po.max_wall_s = max_wall_s;
-  po.progress = p->progress;
-  po.handle_sigint = 1;
-  int prc = go_ipopt_solve(s->nlp, &po, s->z, s->zs, NULL, res, err, errsz);
-  go_gait_set_proximal(s->g, NULL);
-  if (prc != 0) return -1;
-  int conv = solve_converged(res);
-  const double* zp = conv || res->best_iter < 0 ? s->z : s->zs;
-  *viol = conv || res->best_iter < 0 ? res->max_viol : res->best_viol;
-  if (zto != zp) memcpy(zto, zp, sizeof(double) * (size_t)s->n);
-  return 0;
-}
-
-// stages 1-2: the main solve and the restarts after fall-backs and settled solves; 0 or -1
-// with err
+// stages 1-2: the main solve and the restarts after fall-backs; 0 or -1 with err
 static int main_solve(run_state* s, go_ipopt_opts* opts, go_solve_report* rep, char* err,
                       int errsz) {
   const go_solve_plan* p = s->p;
   go_solve_result* res = &rep->result;
   go_ipopt_mult* mult = s->lam ? &s->mult : NULL;
   if (go_ipopt_solve(s->nlp, opts, s->z, s->zb, mult, res, err, errsz) != 0) return -1;
-  int fell_back = 0, settled = 0;  // restarts of each kind done
-  for (;;) {
-    // restarts after a fall-back: Ipopt once came near a solution (violation <= 1e-4) and left
-    // it (the adaptive barrier's fixed mode or a restoration phase raised mu by 3-9 decades and
-    // the objective by 40-600 %; docs/BENCHMARKS.md, "Fall-backs and restarts"). Start again
-    // from the best iterate with the iterations left (set_start_near_solution).
-    // restarts after a settled solve: L-BFGS stalled with a stale memory; a new solve starts
-    // with a fresh one, from the best iterate projected onto the dynamics (as the polish does),
-    // with set_start_near_solution's options. From the best iterate itself (violation 1e-4) the
-    // main job's 0.8 m/s prediction settled again after 74 iterations at the same J; from its
-    // projection (violation 1e-10) it went 3.7 % lower (docs/BENCHMARKS.md, "Predictions
-    // restart once after settling")
-    int after_fall = res->status == GO_SOLVE_FELL_BACK && fell_back < p->max_restarts &&
-                     fell_back < GO_MAX_RESTARTS;
-    int after_settle = res->status == GO_SOLVE_SETTLED && settled < p->settle_restarts &&
-                       settled < GO_MAX_SETTLE_RESTARTS;
-    if (!(after_fall || after_settle) || res->best_iter < 0 ||
-        !(p->max_iter < 0 || res->iterations < p->max_iter) ||
-        !(p->max_wall_s <= 0 || res->wall_s < p->max_wall_s))
-      break;
-    rep->restarts[rep->n_restarts] = (go_solve_restart){after_settle, res->iterations,
-                                                        res->best_iter, res->best_objective,
-                                                        res->best_viol};
+  // restarts after a fall-back: Ipopt once came near a solution (violation <= 1e-4) and left it
+  // (the adaptive barrier's fixed mode or a restoration phase raised mu by 3-9 decades and the
+  // objective by 40-600 %; docs/BENCHMARKS.md, "Fall-backs and restarts"). Start again from the
+  // best iterate with the iterations left (set_start_near_solution)
+  while (res->status == GO_SOLVE_FELL_BACK && res->best_iter >= 0 &&
+         rep->n_restarts < p->max_restarts && rep->n_restarts < GO_MAX_RESTARTS &&
+         (p->max_iter < 0 || res->iterations < p->max_iter) &&
+         (p->max_wall_s <= 0 || res->wall_s < p->max_wall_s)) {
+    rep->restarts[rep->n_restarts] = (go_solve_restart){res->iterations, res->best_iter,
+                                                        res->best_objective, res->best_viol};
     if (p->progress)
-      fprintf(p->progress, "%s: %s after %d iterations; restart from the best iterate "
-              "(iteration %d, objective %.6g, violation %.3g)%s\n", p->label,
-              after_settle ? "settled" : "fell back", res->iterations, res->best_iter,
-              res->best_objective, res->best_viol,
-              after_settle ? " with a fresh quasi-Newton memory" : "");
+      fprintf(p->progress, "%s: fell back after %d iterations; restart from the best iterate "
+              "(iteration %d, objective %.6g, violation %.3g)\n", p->label, res->iterations,
+              res->best_iter, res->best_objective, res->best_viol);
     go_ipopt_opts ro = *opts;
     if (p->max_iter >= 0) ro.max_iter = p->max_iter - res->iterations;
     if (ro.handover_iter > 0)  // counted from the main solve's start
@@ -309,45 +259,17 @@ static int main_solve(run_state* s, go_ipopt_opts* opts, go_solve_report* rep, c
       snprintf(err, (size_t)errsz, "restart: %s", why);
       return -1;
     }
-    if (after_settle) {  // zb becomes its projection when that lowers its violation
-      go_solve_result pres;
-      double viol;
-      double* zp = (double*)malloc(sizeof(double) * (size_t)s->n);
-      if (!zp) {
-        snprintf(err, (size_t)errsz, "restart: out of memory");
-        return -1;
-      }
-      if (p->progress)
-        fprintf(p->progress, "%s: projection onto the dynamics from violation %.3g\n", p->label,
-                res->best_viol);
-      int prc = project_onto_dynamics(s, s->zb, zp, p->polish_iter,
-                                      p->max_wall_s > 0 ? p->max_wall_s - res->wall_s : 0, &pres,
-                                      &viol, why, sizeof(why));
-      if (prc == 0 && viol < res->best_viol) memcpy(s->zb, zp, sizeof(double) * (size_t)s->n);
-      free(zp);
-      if (prc != 0) {
-        snprintf(err, (size_t)errsz, "restart: projection: %s", why);
-        return -1;
-      }
-      res->wall_s += pres.wall_s;
-      res->cpu_s += pres.cpu_s;
-    }
     memcpy(s->z, s->zb, sizeof(double) * (size_t)s->n);
     go_solve_result r2;
     if (go_ipopt_solve(s->nlp, &ro, s->z, s->zb, mult, &r2, why, sizeof(why)) != 0) {
       snprintf(err, (size_t)errsz, "restart: %s", why);
       return -1;
     }
-    // the restart's iteration 0 is the best iterate itself or its projection (pushed 1e-8 off
-    // its bounds), so its best iterate is at least as good by the ranking; counts and times add
-    // up (the projection's time is in res; its iterations are not Ipopt iterations of the solve)
+    // the restart's iteration 0 is the best iterate itself (pushed 1e-8 off its bounds), so its
+    // best iterate is at least as good; counts and times add up
     continue_result(&r2, res);
     *res = r2;
     rep->n_restarts++;
-    if (after_settle)
-      settled++;
-    else
-      fell_back++;
   }
   return 0;
 }
@@ -498,34 +420,44 @@ static int polish(run_state* s, double** zout, go_solve_report* rep, char* err, 
   rep->polish_run = p->polish && (rep->converged || res->best_iter >= 0) &&
                     rep->polish_viol_before > 1e-8;
   if (!rep->polish_run) return 0;
-  double max_wall_s = p->max_wall_s;
-  // after a stop signal, only a quick polish (a second signal ends it at once, writing nothing)
-  if (res->status == GO_SOLVE_INTERRUPTED &&
-      !(max_wall_s > 0 && max_wall_s < p->stop_polish_wall_s))
-    max_wall_s = p->stop_polish_wall_s;
-  if (p->progress)
-    fprintf(p->progress, "%s: feasibility polish from violation %.3g\n", p->label,
-            rep->polish_viol_before);
-  // the projection is written to s->zs first: *zout may be s->z or s->zb
-  double vp;
-  char why[512];
-  double* zp = (double*)malloc(sizeof(double) * (size_t)s->n);
-  if (!zp) {
+  if (go_gait_set_proximal(s->g, *zout) != 0) {
     snprintf(err, (size_t)errsz, "out of memory (polish)");
     return -1;
   }
-  if (project_onto_dynamics(s, *zout, zp, p->polish_iter, max_wall_s, &rep->polish, &vp, why,
-                            sizeof(why)) != 0) {
-    free(zp);
+  if (s->z != *zout) memcpy(s->z, *zout, sizeof(double) * (size_t)s->n);
+  go_ipopt_opts po;
+  char why[512];
+  if (set_polish(&po, why, sizeof(why)) != 0) {
+    go_gait_set_proximal(s->g, NULL);
     snprintf(err, (size_t)errsz, "polish: %s", why);
     return -1;
   }
+  po.max_iter = p->polish_iter;
+  po.max_wall_s = p->max_wall_s;
+  // after a stop signal, only a quick polish (a second signal ends it at once, writing nothing)
+  if (res->status == GO_SOLVE_INTERRUPTED &&
+      !(po.max_wall_s > 0 && po.max_wall_s < p->stop_polish_wall_s))
+    po.max_wall_s = p->stop_polish_wall_s;
+  po.progress = p->progress;
+  po.handle_sigint = 1;
+  if (p->progress)
+    fprintf(p->progress, "%s: feasibility polish from violation %.3g\n", p->label,
+            rep->polish_viol_before);
+  go_solve_result* pres = &rep->polish;
+  int prc = go_ipopt_solve(s->nlp, &po, s->z, s->zs, NULL, pres, why, sizeof(why));
+  go_gait_set_proximal(s->g, NULL);
+  if (prc != 0) {
+    snprintf(err, (size_t)errsz, "polish: %s", why);
+    return -1;
+  }
+  int pconv = solve_converged(pres);
+  const double* zp = pconv || pres->best_iter < 0 ? s->z : s->zs;
+  double vp = pconv || pres->best_iter < 0 ? pres->max_viol : pres->best_viol;
   if (vp < rep->polish_viol_before) {
     memcpy(s->zb, zp, sizeof(double) * (size_t)s->n);
     *zout = s->zb;
     rep->polished = 1;
   }
-  free(zp);
   return 0;
 }
 

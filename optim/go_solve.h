@@ -5,10 +5,6 @@
 //   2. restarts: after a fall-back (GO_SOLVE_FELL_BACK: Ipopt came near a solution, violation
 //      <= fallback_viol, and left it), again from the best iterate with the iterations and time
 //      left, a small barrier and the point barely pushed off its bounds; at most max_restarts;
-//      and after the main solve stopped by the settled rule (GO_SOLVE_SETTLED), with a fresh
-//      L-BFGS memory (a new Ipopt solve) from its best iterate projected onto the dynamics (as
-//      the polish of stage 5 projects), with the same small barrier, at most settle_restarts
-//      times;
 //   3. refinement: an L-BFGS or Gauss-Newton main solve that stopped short (not converged, not
 //      interrupted; with handover_iter, at its first nearly feasible iterate from that iteration
 //      on) is
@@ -89,9 +85,6 @@ typedef struct {
                               // refine_wall_s), the polish gets it whole
   int max_restarts;           // restarts after a fall-back, at most (-; GO_MAX_RESTARTS at
                               // most, the size of go_solve_report.restarts)
-  int settle_restarts;        // restarts after the main solve (or a restart) settled, at most
-                              // (-; GO_MAX_SETTLE_RESTARTS at most); 0: none (the default;
-                              // gaitsim predict: GO_SETTLE_RESTARTS)
   int refine_iter;            // refinement's Newton iterations at most (-); 0: no refinement
   int handover_iter;          // > 0 with a refinement after an L-BFGS main solve: that solve
                               // hands over to the refinement at its first iterate from this
@@ -116,9 +109,8 @@ typedef struct {
                               // start); NULL: from go_solve_run's start
 } go_solve_plan;
 
-// one restart after a fall-back or a settled solve (summary.json "restarts")
+// one restart after a fall-back (summary.json "restarts")
 typedef struct {
-  int after_settled;      // 1: the solve before it settled (GO_SOLVE_SETTLED); 0: it fell back
   int after_iterations;   // iterations done when the solve fell back (-)
   int from_iteration;     // the best iterate it restarted from (-)
   double objective;       // physical objective J there (-)
@@ -133,7 +125,7 @@ typedef struct {
                               // the last of them
   int converged;              // 1: result reached Ipopt's optimal or acceptable level
   int n_restarts;             // restarts done (-)
-  go_solve_restart restarts[GO_MAX_RESTARTS + GO_MAX_SETTLE_RESTARTS];  // in order (n_restarts)
+  go_solve_restart restarts[GO_MAX_RESTARTS];  // in order (n_restarts)
   int refined;                // -1: no refinement run, 0: run and not used, 1: used
   go_solve_result refine;     // the refinement (refined >= 0): its Newton solve, iterations
                               // and times including its Gauss-Newton phase

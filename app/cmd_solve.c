@@ -138,6 +138,8 @@ typedef struct {
   double stride_time;  // predict: > 0: the stride time held at this value (s), 0: free
   double stride_time_start;  // predict: > 0: a free stride time's starting value (s), 0: the
                              // guess's
+  double band_scale;   // predict: factor on the half-widths of eq. 3's band (PREDICT_BAND_*; -),
+                       // 0: no band
 } gsTrackOptions;
 
 // --weight NAME=VALUE
@@ -711,7 +713,8 @@ static char* trial_of_solution(const char* dir) {
 // node times (band, N nz + 1 + 2 nv doubles: node variables, T, then the half-widths of the q and
 // qdot bands), cost of transport with free stride time and the mean speed, the band of eq. 3
 // around the guess: PREDICT_BAND_ROT rad / PREDICT_BAND_TRANS m, PREDICT_BAND_ROT_SPEED rad/s /
-// PREDICT_BAND_TRANS_SPEED m/s (pelvis_tx itself unbounded). Prints the reason on failure.
+// PREDICT_BAND_TRANS_SPEED m/s, each times o->band_scale (pelvis_tx itself unbounded; the paper
+// gives no widths). Prints the reason on failure.
 #define PREDICT_BAND_ROT 0.35         // rad (20 deg)
 #define PREDICT_BAND_TRANS 0.05       // m
 #define PREDICT_BAND_ROT_SPEED 6.0    // rad/s
@@ -759,8 +762,8 @@ static int predict_setup(const mjModel* m, gsTrackOptions* o, go_gait_opts* go, 
   double* bqd = bq + nv;
   for (int j = 0; j < nv; j++) {
     int slide = m->jnt_type[m->dof_jntid[j]] == mjJNT_SLIDE;
-    bq[j] = slide ? PREDICT_BAND_TRANS : PREDICT_BAND_ROT;
-    bqd[j] = slide ? PREDICT_BAND_TRANS_SPEED : PREDICT_BAND_ROT_SPEED;
+    bq[j] = o->band_scale * (slide ? PREDICT_BAND_TRANS : PREDICT_BAND_ROT);
+    bqd[j] = o->band_scale * (slide ? PREDICT_BAND_TRANS_SPEED : PREDICT_BAND_ROT_SPEED);
   }
   go->w_cot = 1.0;
   go->speed = o->speed;
@@ -830,9 +833,11 @@ static void retime_progression(const go_gait* g, double* z, double V, double T0)
 #define GAIT_CONTACT_BW 0.02
 
 // prediction figures for summary.json: speed, stride time and length and their change from the
-// guess, cost of transport, share of the regularisation, peak triceps surae excitations
-static void predict_summary(const go_gait* g, const double* z, const gsTrackOptions* o, double T0,
-                            double dx0, double objective, cJSON* summary) {
+// guess, cost of transport, share of the regularisation, peak triceps surae excitations, and
+// where eq. 3's band holds the solution (band: predict_setup's)
+static void predict_summary(const go_gait* g, const double* z, const gsTrackOptions* o,
+                            const double* band, double T0, double dx0, double objective,
+                            cJSON* summary) {
   const mjModel* m = go_gait_model(g);
   const go_gait_layout* L = go_gait_layout_get(g);
   int N = go_gait_nodes(g);
@@ -872,6 +877,26 @@ static void predict_summary(const go_gait* g, const double* z, const gsTrackOpti
     double mx = 0;
     for (int k = 0; k < N; k++) mx = fmax(mx, z[(size_t)k * L->nz + L->u_e + i]);
     cJSON_AddNumberToObject(pk, peaks[q], mx);
+  }
+  // eq. 3's band: per coordinate (and its speed, "NAME_speed"), the nodes at which the solution
+  // lies within 0.1 % of the band's half-width from its edge, so that the band, not the
+  // objective, placed it there; coordinates never at the band are left out
+  cJSON_AddNumberToObject(summary, "band_scale", o->band_scale);
+  cJSON* ba = cJSON_AddObjectToObject(summary, "band_active_nodes");
+  const double* bq = band + (size_t)N * L->nz + 1;
+  for (int j = 0; j < m->nv; j++) {
+    const char* name = mj_id2name(m, mjOBJ_JOINT, m->dof_jntid[j]);
+    for (int sp = 0; sp < 2; sp++) {
+      double hw = bq[sp * m->nv + j];
+      int col = (sp ? L->x_qd : L->x_q) + j, at = 0;
+      if (!(hw > 0) || (!sp && j == L->tx)) continue;
+      for (int k = 0; k < N; k++)
+        at += fabs(z[(size_t)k * L->nz + col] - band[(size_t)k * L->nz + col]) >= (1 - 1e-3) * hw;
+      if (!at) continue;
+      char key[128];
+      snprintf(key, sizeof(key), "%s%s", name ? name : "dof", sp ? "_speed" : "");
+      cJSON_AddNumberToObject(ba, key, at);
+    }
   }
 }
 
@@ -926,7 +951,13 @@ static const char* kPredictUsage =
     "  --jacobian forward|central  finite differences of the path rows in the main solve:\n"
     "                      forward (half the model evaluations per Jacobian) or central\n"
     "                      (default " GO_PREDICT_JACOBIAN_NAME "; the polish uses central ones)\n"
-    "  --no-polish         no feasibility polish of a solve that stopped short\n"
+    "  --no-polish         no feasibility polish of a solve that stopped short\n";
+// (in two parts: C11 compilers need not take string literals over 4095 characters)
+static const char* kPredictUsageBand =
+    "  --band-scale F      factor on the half-widths of eq. 3's band around the guess (20 deg,\n"
+    "                      5 cm, 6 rad/s, 1 m/s; the paper gives none): default 1, 0: no band;\n"
+    "                      summary.json band_active_nodes counts, per coordinate and speed, the\n"
+    "                      nodes the band holds\n"
     "  --fallback-rise F   stop when the objective rises by more than the fraction F above the\n"
     "                      lowest one reached at a violation <= " GO_STR(GO_FALLBACK_VIOL)
     ", and restart from the\n"
@@ -949,7 +980,8 @@ int gs_cmd_predict(int argc, char** argv) {
       {"min-vgrf", required_argument, NULL, 'W'},
       {"stride-time", required_argument, NULL, 'D'},
       {"stride-time-start", required_argument, NULL, 'E'},
-      {"jacobian", required_argument, NULL, 'J'},             {NULL, 0, NULL, 0}};
+      {"jacobian", required_argument, NULL, 'J'},
+      {"band-scale", required_argument, NULL, 'B'},           {NULL, 0, NULL, 0}};
   gsTrackOptions o;
   defaults(&o);
   o.predict = 1;
@@ -966,11 +998,12 @@ int gs_cmd_predict(int argc, char** argv) {
   o.metabolic_smoothing = GO_PREDICT_METABOLIC_SMOOTHING;
   o.fibre_bounds = 1;
   o.min_vgrf = GO_PREDICT_MIN_VGRF;
+  o.band_scale = 1;
   optind = 1;
   opterr = 0;
   int c, bad = 0, model_given = 0, nodes_given = 0;
   char err[256];
-  while (!bad && (c = getopt_long(argc, argv, ":g:s:o:m:n:t:i:T:w:PFS:R:W:D:E:J:p:h", options,
+  while (!bad && (c = getopt_long(argc, argv, ":g:s:o:m:n:t:i:T:w:PFS:R:W:D:E:J:B:p:h", options,
                                   NULL)) != -1) {
     switch (c) {
       case 'g': o.guess = optarg; break;
@@ -991,6 +1024,7 @@ int gs_cmd_predict(int argc, char** argv) {
         break;
       case 'w': bad = parse_weight(optarg, &o); break;
       case 'P': o.plan.polish = 0; break;
+      case 'B': bad = gs_opt_real("--band-scale", optarg, 0, 10, 0, &o.band_scale); break;
       case 'F': o.fibre_bounds = 0; break;
       case 'D': bad = gs_opt_real("--stride-time", optarg, 0.4, 2.5, 0, &o.stride_time); break;
       case 'E':
@@ -1019,7 +1053,10 @@ int gs_cmd_predict(int argc, char** argv) {
           bad = 1;
         }
         break;
-      case 'h': fputs(kPredictUsage, stdout); return GS_EXIT_OK;
+      case 'h':
+        fputs(kPredictUsage, stdout);
+        fputs(kPredictUsageBand, stdout);
+        return GS_EXIT_OK;
       default: return gs_opt_getopt_error("predict", c, argv);
     }
   }
@@ -1229,7 +1266,7 @@ static int solve(gsTrackOptions o) {
   cJSON_AddNumberToObject(summary, "stride_time_s", go_gait_time_of(g, rep.z));
   cJSON_AddNumberToObject(summary, "body_weight_n", go_gait_weight(g));
   if (o.predict) {
-    predict_summary(g, rep.z, &o, T0, dx0, rep.objective, summary);
+    predict_summary(g, rep.z, &o, band, T0, dx0, rep.objective, summary);
   } else {
     cJSON_AddNumberToObject(summary, "grf_scale", grf_scale);
   }

@@ -62,6 +62,7 @@ static const optRule kRules[] = {
     {"stride-time", KIND_PREDICT, OPT_NUM, 0.4, 2.5, 0, NULL},
     {"stride-time-start", KIND_PREDICT, OPT_NUM, 0.4, 2.5, 0, NULL},
     {"jacobian", KIND_PREDICT, OPT_ENUM, 0, 0, 0, "forward|central"},
+    {"band-scale", KIND_PREDICT, OPT_NUM, 0, 10, 0, NULL},
 };
 #define NRULES ((int)(sizeof(kRules) / sizeof(kRules[0])))
 

@@ -21,18 +21,14 @@ check "guess written" test -s track/variables.sto
   --threads 2 --band-scale 0.25 --out narrow >/dev/null 2>&1
 status=$?
 check "narrow band: exit 0 (got $status)" test "$status" -eq 0
-check "band_active_nodes recomputed from the states" /usr/bin/python3 - track/states.sto \
-  narrow/states.sto narrow/summary.json <<'PY'
+check "band_active_nodes recomputed from the states" /usr/bin/python3 - "$src/scripts" \
+  track/states.sto narrow/states.sto narrow/summary.json <<'PY'
 import json, math, sys
-def sto(p):
-    lines = open(p).read().splitlines()
-    i = lines.index("endheader")
-    head = lines[i + 1].split("\t")
-    rows = [[float(x) for x in l.split("\t")] for l in lines[i + 2:] if l.strip()]
-    return head, rows
-hg, g = sto(sys.argv[1])
-hp, p = sto(sys.argv[2])
-s = json.load(open(sys.argv[3]))
+sys.path.insert(0, sys.argv[1])
+from gs_scriptlib import read_storage
+_, hg, g = read_storage(sys.argv[2])
+_, hp, p = read_storage(sys.argv[3])
+s = json.load(open(sys.argv[4]))
 scale, deg = 0.25, 180 / math.pi
 slides = {"pelvis_tx", "pelvis_ty"}
 want = {}

@@ -1224,6 +1224,8 @@ static int solve(gsTrackOptions o) {
     cJSON_AddStringToObject(summary, "trial", o.trial);
   }
   cJSON_AddStringToObject(summary, "status", go_solve_status_str(res->status));
+  if (res->status == GO_SOLVE_EVAL_ERROR)  // which evaluation failed last ("": none of ours)
+    cJSON_AddStringToObject(summary, "eval_error", res->eval_error);
   cJSON_AddNumberToObject(summary, "iterations", res->iterations);
   cJSON* restarts = cJSON_AddArrayToObject(summary, "restarts");  // after fall-backs, in order
   for (int r = 0; r < rep.n_restarts; r++) {
@@ -1316,6 +1318,9 @@ static int solve(gsTrackOptions o) {
   printf("%s: %s after %d iterations, %.1f s; max violation %.3g (from %.3g); wrote %s\n", what,
          go_solve_status_str(res->status), res->iterations, res->wall_s, rep.max_violation,
          rep.initial_violation, o.out);
+  if (res->status == GO_SOLVE_EVAL_ERROR)
+    printf("%s: the last failed evaluation: %s\n", what,
+           res->eval_error[0] ? res->eval_error : "none (Ipopt's own arithmetic)");
   status = rep.converged ? GS_EXIT_OK : GS_EXIT_STOPPED_SHORT;
 
 done:

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "callbacks/gs_model_info.h"
+#include "callbacks/gs_tendon_paths.h"
 
 static int find(const mjModel* m, int type, const char* name, int* id, char* err, int errsz) {
   *id = mj_name2id(m, type, name);
@@ -71,7 +72,7 @@ static void knee_frame(const mjData* d, const gsBalanceSpec* spec, int s, const 
 
 void gs_balance_eval(const mjModel* m, mjData* d, const gsBalanceSpec* spec, const double* qacc,
                      const gsFootLoad load[2], gsBalance* out) {
-  mj_fwdPosition(m, d);  // kinematics, centres of mass, M (d->qM)
+  gs_fwd_position(m, d);  // kinematics, centres of mass, M (d->qM); tendons finite
   mj_fwdVelocity(m, d);  // c (d->qfrc_bias), body velocities
   mj_subtreeVel(m, d);
   const double* com = d->subtree_com + 3 * spec->root_body;

@@ -7,6 +7,7 @@
 
 #include "callbacks/gs_model_info.h"
 #include "callbacks/gs_physics.h"
+#include "callbacks/gs_tendon_paths.h"
 
 static const double kLoadedN = 5.0;  // a foot carries load above this normal force (N)
 
@@ -23,7 +24,7 @@ void gs_lib_install(void) {
 }
 
 void gs_lib_equilibrate(const mjModel* m, mjData* d) {
-  mj_fwdPosition(m, d);
+  gs_fwd_position(m, d);
   gs_physics_equilibrate_tendons(m, d, NULL);
 }
 

@@ -11,6 +11,7 @@
 #include "callbacks/gs_model_info.h"
 #include "callbacks/gs_muscle.h"
 #include "callbacks/gs_physics.h"
+#include "callbacks/gs_tendon_paths.h"
 #include "optim/go_defaults.h"
 #include "optim/go_jacobian.h"
 
@@ -152,7 +153,7 @@ static void set_node_inputs(const go_gait* g, mjData* d, const double* z) {
 
 void go_gait_load_node(const go_gait* g, mjData* d, const double* z) {
   set_node_inputs(g, d, z);
-  mj_inverse(g->m, d);
+  gs_inverse(g->m, d);
 }
 
 // go_gait_load_node on the worker's data, reusing its position stage when z's coordinates equal
@@ -173,7 +174,7 @@ static void node_inverse(gait_ctx* c, const double* z) {
     c->pos_reused++;
     return;
   }
-  mj_inverse(g->m, d);
+  gs_inverse(g->m, d);
   memcpy(c->pos_q, z + g->L.x_q, sizeof(double) * (size_t)nv);
   c->pos_valid = 1;
 }
@@ -402,7 +403,7 @@ static void muscle_powers(const go_gait* g, mjData* d, const double* z, int kine
   if (kinematics) {
     mju_copy(d->qpos, z + L->x_q, L->nv);
     mju_copy(d->qvel, z + L->x_qd, L->nv);
-    mj_fwdPosition(m, d);
+    gs_fwd_position(m, d);
     mj_fwdVelocity(m, d);
   }
   mju_copy(d->act, z + L->x_a, L->na);
@@ -504,6 +505,7 @@ static double metabolic(const go_gait* g, gait_ctx* c, const double* z, double* 
       mj_kinematics(m, d);
       mj_comPos(m, d);
       mj_tendon(m, d);
+      gs_tendon_repair(m, d);
       mj_transmission(m, d);
       mju_addToScl(dr, d->actuator_moment, s == 0 ? 1.0 / (2 * eps) : -1.0 / (2 * eps),
                    na * nv);
@@ -743,7 +745,7 @@ static int crossing(go_gait* g, const gsTable* coords, const int* qcol) {
         d->qpos[j] += (m->jnt_type[jnt] == mjJNT_SLIDE ? 0.03 : 0.35) * lcg(&seed);
       }
     }
-    mj_fwdPosition(m, d);
+    gs_fwd_position(m, d);
     for (int i = 0; i < na; i++) {
       for (int j = 0; j < nv; j++) {
         if (fabs(d->actuator_moment[i * nv + j]) > CROSS_TOL) {

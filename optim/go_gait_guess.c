@@ -11,6 +11,7 @@
 #include "callbacks/gs_muscle.h"
 #include "callbacks/gs_physics.h"
 #include "callbacks/gs_state.h"
+#include "callbacks/gs_tendon_paths.h"
 
 // periodic central difference of y (n samples at times t, y[n-1] the same phase as y[0]) into dy
 static void periodic_diff(const double* t, const double* y, int n, int stride, double* dy) {
@@ -84,7 +85,7 @@ int go_gait_guess_from_trial(const go_gait* g, const gsTable* coords, double act
     }
     mju_copy(d->qpos, zk + L->x_q, nv);
     mju_copy(d->qvel, zk + L->x_qd, nv);
-    mj_fwdPosition(m, d);
+    gs_fwd_position(m, d);
     mj_fwdVelocity(m, d);
     for (int e = 0; e < L->ne; e++) {
       int i = L->elastic[e];
@@ -127,7 +128,7 @@ int go_gait_guess_from_trial(const go_gait* g, const gsTable* coords, double act
 static void node_grf(const mjModel* m, const go_gait_layout* L, mjData* d, double* zk) {
   mju_copy(d->qpos, zk + L->x_q, L->nv);
   mju_copy(d->qvel, zk + L->x_qd, L->nv);
-  mj_fwdPosition(m, d);
+  gs_fwd_position(m, d);
   mj_fwdVelocity(m, d);
   for (int s = 0; s < 2; s++) {
     gsFootGrf fg;
@@ -185,7 +186,7 @@ int go_gait_guess_from_solution(const go_gait* g, const gsTable* states, const g
       zk[L->u_e + i] = fmin(fmax(controls && cmap.ctrl_col[i] >= 0 ? d->ctrl[i] : d->act[i],
                                  0.001), 1.0);
     }
-    mj_fwdPosition(m, d);
+    gs_fwd_position(m, d);
     for (int e = 0; e < L->ne; e++) {
       int i = L->elastic[e];
       double fT = d->userdata[i];

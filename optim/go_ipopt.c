@@ -250,8 +250,19 @@ typedef struct {
   int settle_it[GO_IPOPT_MAX_SETTLE];    // the latest iterations near feasibility, newest last
   double settle_J[GO_IPOPT_MAX_SETTLE];  // their physical objectives
   int settle_n;                          // entries used (at most settle_iter)
+  char eval_error[160];  // the latest failed evaluation: which callback, and go_nlp_last_error
   struct timespec t0;
 } solve_state;
+
+// note a failed evaluation of callback what (Ipopt sees FALSE: a failed derivative ends the solve
+// with Invalid_Number_Detected, a failed function value only shortens the step); the Hessians
+// set no reason of their own, so theirs says only that they failed
+static void note_eval_error(solve_state* s, const char* what) {
+  if (strstr(what, "Hessian"))
+    snprintf(s->eval_error, sizeof(s->eval_error), "%s: failed or non-finite", what);
+  else
+    snprintf(s->eval_error, sizeof(s->eval_error), "%s: %s", what, go_nlp_last_error(s->nlp));
+}
 
 static double elapsed(const struct timespec* t0) {
   struct timespec t;
@@ -267,7 +278,10 @@ static double cpu_now(void) {
 
 static Bool cb_f(Index n, Number* x, Bool new_x, Number* f, UserDataPtr u) {
   solve_state* s = u;
-  if (go_nlp_eval_f(s->nlp, x, f)) return FALSE;
+  if (go_nlp_eval_f(s->nlp, x, f)) {
+    note_eval_error(s, "objective");
+    return FALSE;
+  }
   memcpy(s->xf, x, sizeof(double) * (size_t)n);
   s->fval = *f;
   s->have_f = 1;
@@ -276,12 +290,17 @@ static Bool cb_f(Index n, Number* x, Bool new_x, Number* f, UserDataPtr u) {
 
 static Bool cb_grad_f(Index n, Number* x, Bool new_x, Number* grad, UserDataPtr u) {
   solve_state* s = u;
-  return go_nlp_eval_grad_f(s->nlp, x, grad) ? FALSE : TRUE;
+  if (go_nlp_eval_grad_f(s->nlp, x, grad)) {
+    note_eval_error(s, "objective gradient");
+    return FALSE;
+  }
+  return TRUE;
 }
 
 static Bool cb_g(Index n, Number* x, Bool new_x, Index m, Number* g, UserDataPtr u) {
   solve_state* s = u;
   if (go_nlp_eval_g(s->nlp, x, g)) {
+    note_eval_error(s, "constraints");
     s->have_g = 0;
     return FALSE;
   }
@@ -298,7 +317,10 @@ static Bool cb_jac(Index n, Number* x, Bool new_x, Index m, Index nele, Index* i
     go_nlp_jac_structure(s->nlp, irow, jcol);
     return TRUE;
   }
-  if (go_nlp_eval_jac(s->nlp, x, vals)) return FALSE;
+  if (go_nlp_eval_jac(s->nlp, x, vals)) {
+    note_eval_error(s, "constraint Jacobian");
+    return FALSE;
+  }
   if (s->opts->hess) go_hess_note_jacobian(s->opts->hess, x, vals);
   // the Jacobian is evaluated at iterates only: remember the point for the best iterate
   memcpy(s->xj, x, sizeof(double) * (size_t)n);
@@ -317,14 +339,18 @@ static Bool cb_h(Index n, Number* x, Bool new_x, Number obj_factor, Index m, Num
       go_hess_structure(s->opts->hess, irow, jcol);
       return TRUE;
     }
-    return go_hess_values(s->opts->hess, x, obj_factor, lambda, vals) == 0 ? TRUE : FALSE;
+    if (go_hess_values(s->opts->hess, x, obj_factor, lambda, vals) == 0) return TRUE;
+    note_eval_error(s, "Hessian");
+    return FALSE;
   }
   if (!s->opts->gauss_newton) return FALSE;
   if (!vals) {
     for (Index i = 0; i < n; i++) irow[i] = jcol[i] = i;
     return TRUE;
   }
-  return go_nlp_eval_hess_diag(s->nlp, x, obj_factor, vals) == 0 ? TRUE : FALSE;
+  if (go_nlp_eval_hess_diag(s->nlp, x, obj_factor, vals) == 0) return TRUE;
+  note_eval_error(s, "Gauss-Newton Hessian");
+  return FALSE;
 }
 
 // does (f, viol) beat the best so far?
@@ -654,6 +680,7 @@ int go_ipopt_solve(go_nlp* nlp, const go_ipopt_opts* opts, double* z, double* z_
   res->last_inf_du = s.last_inf_du;
   res->last_mu = s.last_mu;
   res->last_restoration = s.last_alg_mod != 0;
+  snprintf(res->eval_error, sizeof(res->eval_error), "%s", s.eval_error);
   double f = NAN, viol = INFINITY;
   if (!go_nlp_eval_g(nlp, x, s.gtmp)) viol = m > 0 ? go_nlp_violation(nlp, s.gtmp) : 0.0;
   if (go_nlp_eval_f(nlp, x, &f)) f = NAN;

@@ -113,6 +113,8 @@ typedef struct {
   double last_inf_du;       // Ipopt's dual infeasibility at its last iteration (scaled, max norm)
   double last_mu;           // Ipopt's barrier parameter at its last iteration (-)
   int last_restoration;     // 1: the last iteration was a restoration-phase iteration
+  char eval_error[160];     // the solve's latest failed evaluation, "callback: why" ("": none);
+                            // with GO_SOLVE_EVAL_ERROR the one that ended it
 } go_solve_result;
 
 // optional multipliers in the solver's scaling: in (when warm != 0) and out (when non-NULL)

@@ -15,9 +15,11 @@
 enum { N = 21, NZ = 5 };
 
 static int raise_after = -1;  // path calls before raising SIGINT (-1: never)
+static int fail_at_node = -1;  // node whose path evaluation fails (-1: none)
 
 static int path(void* ctx, int k, const double* z, double* g) {
   if (raise_after >= 0 && raise_after-- == 0) raise(SIGINT);
+  if (k == fail_at_node) return 1;
   g[0] = z[2] - z[1];
   g[1] = z[3] - z[4];
   return 0;
@@ -295,6 +297,20 @@ int main(void) {
   EXPECT_EQ_INT(0, go_ipopt_opts_add(&o, "max_iter=abc", err, sizeof(err)));
   EXPECT_EQ_INT(-1, go_ipopt_solve(nlp, &o, z, NULL, NULL, &r, err, sizeof(err)));
   EXPECT_TRUE(strstr(err, "integer") != NULL);
+
+  // a failed evaluation: the status, and which callback at which node
+  go_ipopt_opts_default(&o);
+  guess(z);
+  fail_at_node = 7;
+  solve(nlp, &o, z, NULL, NULL, &r, &rc, err);
+  fail_at_node = -1;
+  EXPECT_EQ_INT(0, rc);
+  EXPECT_EQ_INT(GO_SOLVE_EVAL_ERROR, r.status);
+  EXPECT_TRUE(strstr(r.eval_error, "node 7: callback failed") != NULL);
+  printf("failed evaluation: %s\n", r.eval_error);
+  solve(nlp, &o, z, NULL, NULL, &r, &rc, err);
+  EXPECT_EQ_INT(GO_SOLVE_SUCCESS, r.status);
+  EXPECT_EQ_INT(0, (int)strlen(r.eval_error));
 
   // every status has a text
   for (int s = GO_SOLVE_SUCCESS; s <= GO_SOLVE_INTERNAL_ERROR; s++)

@@ -408,15 +408,17 @@ kept:
   return 0;
 }
 
-// stage 5: the feasibility polish of *zout (Ipopt's point when converged, whose acceptable test
-// allows a violation of 1e-4, else the best iterate; go_gait_set_proximal), by Gauss-Newton,
-// whenever that point is violated by more than 1e-8; *zout becomes zb when the polished point
-// is less violated. 0 or -1 with err
+// stage 5: the feasibility polish of *zout (Ipopt's point when converged and not settled, whose
+// acceptable test allows a violation of 1e-4, else the best iterate; go_gait_set_proximal), by
+// Gauss-Newton, whenever that point is violated by more than 1e-8; *zout becomes zb when the
+// polished point is less violated than *zout. 0 or -1 with err
 static int polish(run_state* s, double** zout, go_solve_report* rep, char* err, int errsz) {
   const go_solve_plan* p = s->p;
   const go_solve_result* res = &rep->result;
-  rep->polish_viol_before = rep->converged ? res->max_viol : res->best_viol;
-  rep->polish_obj_before = rep->converged ? res->objective : res->best_objective;
+  // the point polished is Ipopt's or the best iterate (a settled solve's, though it converged)
+  int from_best = *zout == s->zb;
+  rep->polish_viol_before = from_best ? res->best_viol : res->max_viol;
+  rep->polish_obj_before = from_best ? res->best_objective : res->objective;
   rep->polish_run = p->polish && (rep->converged || res->best_iter >= 0) &&
                     rep->polish_viol_before > 1e-8;
   if (!rep->polish_run) return 0;

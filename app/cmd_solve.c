@@ -765,6 +765,7 @@ static int predict_setup(const mjModel* m, gsTrackOptions* o, go_gait_opts* go, 
     bq[j] = o->band_scale * (slide ? PREDICT_BAND_TRANS : PREDICT_BAND_ROT);
     bqd[j] = o->band_scale * (slide ? PREDICT_BAND_TRANS_SPEED : PREDICT_BAND_ROT_SPEED);
   }
+  bq[L->tx] = 0;  // pelvis_tx advances over the stride: no band on it (go_gait skips it too)
   go->w_cot = 1.0;
   go->speed = o->speed;
   go->free_time = 1;
@@ -889,7 +890,7 @@ static void predict_summary(const go_gait* g, const double* z, const gsTrackOpti
     for (int sp = 0; sp < 2; sp++) {
       double hw = bq[sp * m->nv + j];
       int col = (sp ? L->x_qd : L->x_q) + j, at = 0;
-      if (!(hw > 0) || (!sp && j == L->tx)) continue;
+      if (!(hw > 0)) continue;
       for (int k = 0; k < N; k++)
         at += fabs(z[(size_t)k * L->nz + col] - band[(size_t)k * L->nz + col]) >= (1 - 1e-3) * hw;
       if (!at) continue;

@@ -4,10 +4,12 @@
 # a prediction at 1.2 m/s with the band a quarter as wide (--band-scale 0.25: 5 deg, 1.25 cm,
 # 1.5 rad/s, 0.25 m/s; measured: settles after 103 iterations with 11 coordinates and speeds at
 # the band at 1-5 nodes each). Expected: summary.json band_scale 0.25 and band_active_nodes equal,
-# coordinate by coordinate, to the count recomputed from states.sto against the guess's states.sto
-# (nodes within 0.1 % of the half-width from the band's edge; pelvis_tx itself has no band, its
-# speed has), and not empty; without a band (--band-scale 0) none held; a negative scale or one
-# above 10 is bad usage (exit 2).
+# coordinate by coordinate, to the count scripts/band_excursions.py recomputes from states.sto
+# against the guess's states.sto (nodes within 0.1 % of the half-width from the band's edge;
+# pelvis_tx itself has no band, its speed has), none beyond the band, and not empty; against a
+# band narrower than the solve's (x 0.2) some nodes lie beyond; without a band (--band-scale 0)
+# none held; a negative scale or one above 10 is bad usage (exit 2), and so is a scale that is
+# not a number to the script.
 # usage: band.sh GAITSIM SOURCE_DIR
 set -u
 gaitsim=$1 src=$2
@@ -21,36 +23,28 @@ check "guess written" test -s track/variables.sto
   --threads 2 --band-scale 0.25 --out narrow >/dev/null 2>&1
 status=$?
 check "narrow band: exit 0 (got $status)" test "$status" -eq 0
-check "band_active_nodes recomputed from the states" /usr/bin/python3 - "$src/scripts" \
-  track/states.sto narrow/states.sto narrow/summary.json <<'PY'
-import json, math, sys
-sys.path.insert(0, sys.argv[1])
-from gs_scriptlib import read_storage
-_, hg, g = read_storage(sys.argv[2])
-_, hp, p = read_storage(sys.argv[3])
-s = json.load(open(sys.argv[4]))
-scale, deg = 0.25, 180 / math.pi
-slides = {"pelvis_tx", "pelvis_ty"}
-want = {}
-for name in hp[1:]:
-    if "." in name:
-        continue
-    speed = name.endswith("_u")
-    coord = name[:-2] if speed else name
-    if coord == "pelvis_tx" and not speed:
-        continue
-    slide = coord in slides
-    hw = scale * ((1.0 if slide else 6.0 * deg) if speed else (0.05 if slide else 0.35 * deg))
-    jp, jg = hp.index(name), hg.index(name)
-    at = sum(abs(p[k][jp] - g[k][jg]) >= (1 - 1e-3) * hw for k in range(len(p)))
-    if at:
-        want[coord + ("_speed" if speed else "")] = at
+/usr/bin/python3 "$src/scripts/band_excursions.py" track narrow --json > excursions.json
+check "band_excursions.py: exit 0" test $? -eq 0
+check "band_active_nodes recomputed from the states (scripts/band_excursions.py)" \
+  /usr/bin/python3 - narrow/summary.json excursions.json <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+e = json.load(open(sys.argv[2]))
 got = s["band_active_nodes"]
-ok = s["band_scale"] == 0.25 and got == want and len(got) > 0 and len(p) == len(g) == 20
+ok = (s["band_scale"] == 0.25 and e["band_scale"] == 0.25 and got == e["at_edge"] and
+      len(got) > 0 and not any(e["beyond"].values()) and "pelvis_tx" not in got)
 if not ok:
-    print(json.dumps({"summary": got, "recomputed": want}), file=sys.stderr)
+    print(json.dumps({"summary": got, "recomputed": e}), file=sys.stderr)
 sys.exit(0 if ok else 1)
 PY
+/usr/bin/python3 "$src/scripts/band_excursions.py" track narrow --band-scale 0.2 --json \
+  > tighter.json
+check "a tighter band than the solve's: nodes beyond it" /usr/bin/python3 -c "
+import json, sys
+e = json.load(open('tighter.json'))
+sys.exit(0 if sum(e['beyond'].values()) > 0 else 1)"
+/usr/bin/python3 "$src/scripts/band_excursions.py" track narrow --band-scale x >/dev/null 2>&1
+check "band_excursions.py --band-scale x: exit 2" test $? -eq 2
 "$gaitsim" predict --guess track --model "$model" --speed 1.2 --nodes 20 --max-iter 50 \
   --threads 2 --band-scale 0 --out none >/dev/null 2>&1
 check "no band: band_scale 0, none held" /usr/bin/python3 -c "

@@ -53,7 +53,9 @@ static const char* kSweepUsage =
     "  --max-time S    wall-clock limit of each solve, s (default none: the iteration limit,\n"
     "                  so that the results do not depend on the load of the machine)\n"
     "  --max-iter N    Ipopt iteration limit of each solve (default " GO_STR(GO_MAX_ITER)
-    ")\n";
+    ")\n"
+    "  --band-scale F  factor on the half-widths of eq. 3's band around the guess, as gaitsim\n"
+    "                  predict (default 1; 0 removes the band; 0-10)\n";
 
 // the guess's mean speed (summary.json speed_mps), or NAN
 static double guess_speed(const char* dir) {
@@ -82,9 +84,16 @@ static double column_max(const char* dir, const char* file, const char* label) {
   return mx;
 }
 
+// predict's options every speed gets, as the words given to sweep (NULL: predict's default)
+typedef struct {
+  const char* nodes;       // --nodes
+  const char* max_time;    // --max-time
+  const char* max_iter;    // --max-iter (never NULL: sweep's default is GO_MAX_ITER)
+  const char* band_scale;  // --band-scale
+} sweep_predict_opts;
+
 // one predictive solve: speed v from guess into out, progress into out/log.txt
-static int solve_one(const char* guess, double v, const char* out, const char* nodes,
-                     const char* max_time, const char* max_iter) {
+static int solve_one(const char* guess, double v, const char* out, const sweep_predict_opts* po) {
   char speed[32], log[4200], final_log[4200];
   snprintf(speed, sizeof(speed), "%.4g", v);
   // the progress goes to OUT.log while predict writes OUT whole, then into OUT/log.txt (a solve
@@ -95,17 +104,17 @@ static int solve_one(const char* guess, double v, const char* out, const char* n
   int saved = dup(2);
   FILE* lf = fopen(log, "w");
   if (lf) dup2(fileno(lf), 2);
-  // --nodes and --max-time only when given (predict then takes the guess's node count)
-  char* argv[16] = {"predict", "--guess", (char*)guess, "--speed", speed, "--out", (char*)out,
-                    "--threads", "1", "--max-iter", (char*)max_iter};
+  // --nodes, --max-time and --band-scale only when given (predict then takes the guess's node
+  // count, no time limit, the band x 1)
+  char* argv[18] = {"predict", "--guess", (char*)guess, "--speed", speed, "--out", (char*)out,
+                    "--threads", "1", "--max-iter", (char*)po->max_iter};
   int argc = 11;
-  if (nodes) {
-    argv[argc++] = "--nodes";
-    argv[argc++] = (char*)nodes;
-  }
-  if (max_time) {
-    argv[argc++] = "--max-time";
-    argv[argc++] = (char*)max_time;
+  const char* given[3][2] = {{"--nodes", po->nodes}, {"--max-time", po->max_time},
+                             {"--band-scale", po->band_scale}};
+  for (int i = 0; i < 3; i++) {
+    if (!given[i][1]) continue;
+    argv[argc++] = (char*)given[i][0];
+    argv[argc++] = (char*)given[i][1];
   }
   argv[argc] = NULL;
   int rc = gs_cmd_predict(argc, argv);
@@ -133,7 +142,7 @@ static int solve_one(const char* guess, double v, const char* out, const char* n
 
 // solve the speeds idx[0..n) in order, each from the previous one (the first from guess)
 static int chain(const char* guess, const double* v, const int* idx, int n, const char* dir,
-                 const char* nodes, const char* max_time, const char* max_iter) {
+                 const sweep_predict_opts* po) {
   char prev[4096], out[4096];
   snprintf(prev, sizeof(prev), "%s", guess);
   int worst = GS_EXIT_OK;
@@ -143,7 +152,7 @@ static int chain(const char* guess, const double* v, const int* idx, int n, cons
       return GS_EXIT_STOPPED_SHORT;
     }
     snprintf(out, sizeof(out), "%s/predict_%.4g", dir, v[idx[i]]);
-    int rc = solve_one(prev, v[idx[i]], out, nodes, max_time, max_iter);
+    int rc = solve_one(prev, v[idx[i]], out, po);
     if (rc != GS_EXIT_OK && rc != GS_EXIT_STOPPED_SHORT) return rc;
     if (rc == GS_EXIT_STOPPED_SHORT) worst = rc;
     snprintf(prev, sizeof(prev), "%s", out);
@@ -156,7 +165,7 @@ static int chain(const char* guess, const double* v, const int* idx, int n, cons
 // not stop the others. Returns the first failure, else GS_EXIT_STOPPED_SHORT when a solve stopped
 // short or a speed was not started, else GS_EXIT_OK.
 static int from_guess(const char* guess, const double* v, int n, int jobs, const char* dir,
-                      const char* nodes, const char* max_time, const char* max_iter) {
+                      const sweep_predict_opts* po) {
   pid_t running[SWEEP_MAX_JOBS] = {0};
   int nrun = 0, next = 0, failed = GS_EXIT_OK, stopped_short = 0;
   while (next < n || nrun > 0) {
@@ -166,7 +175,7 @@ static int from_guess(const char* guess, const double* v, int n, int jobs, const
       fflush(stdout);
       fflush(stderr);
       pid_t pid = (pid_t)go_ipopt_fork_forwarded();
-      if (pid == 0) _exit(solve_one(guess, v[next], out, nodes, max_time, max_iter));
+      if (pid == 0) _exit(solve_one(guess, v[next], out, po));
       if (pid > 0) running[nrun++] = pid;
       if (pid < 0) {
         fprintf(stderr, "gaitsim: sweep: %.4g m/s: fork: %s\n", v[next], strerror(errno));
@@ -205,25 +214,30 @@ int gs_cmd_sweep(int argc, char** argv) {
       {"out", required_argument, NULL, 'o'},     {"nodes", required_argument, NULL, 'n'},
       {"max-time", required_argument, NULL, 'T'}, {"max-iter", required_argument, NULL, 'i'},
       {"start", required_argument, NULL, 'S'},   {"jobs", required_argument, NULL, 'j'},
-      {"help", no_argument, NULL, 'h'},
+      {"band-scale", required_argument, NULL, 'B'}, {"help", no_argument, NULL, 'h'},
       {NULL, 0, NULL, 0}};
   static const char* const starts[] = {"guess", "neighbour", NULL};
   int start = 0, jobs = SWEEP_DEFAULT_JOBS;
-  const char *guess = NULL, *dir = NULL, *nodes = NULL, *max_time = NULL;
-  const char* max_iter = GO_STR(GO_MAX_ITER);
+  const char *guess = NULL, *dir = NULL;
+  sweep_predict_opts po = {NULL, NULL, GO_STR(GO_MAX_ITER), NULL};
+  double band_scale = 1;
   double v[SWEEP_MAX_SPEEDS];
   int n = -1, c, bad = 0;
   optind = 1;
   opterr = 0;
   // every value checked here; predict gets the words as given
-  while (!bad && (c = getopt_long(argc, argv, ":g:s:o:n:T:i:S:j:h", options, NULL)) != -1) {
+  while (!bad && (c = getopt_long(argc, argv, ":g:s:o:n:T:i:S:j:B:h", options, NULL)) != -1) {
     switch (c) {
       case 'g': guess = optarg; break;
       case 's': bad = (n = gs_opt_speeds("--speeds", optarg, v)) < 0; break;
       case 'o': dir = optarg; break;
-      case 'n': bad = gs_opt_solve_limit(c, optarg, &nodes); break;
-      case 'T': bad = gs_opt_solve_limit(c, optarg, &max_time); break;
-      case 'i': bad = gs_opt_solve_limit(c, optarg, &max_iter); break;
+      case 'n': bad = gs_opt_solve_limit(c, optarg, &po.nodes); break;
+      case 'T': bad = gs_opt_solve_limit(c, optarg, &po.max_time); break;
+      case 'i': bad = gs_opt_solve_limit(c, optarg, &po.max_iter); break;
+      case 'B':
+        bad = gs_opt_real("--band-scale", optarg, 0, 10, 0, &band_scale);
+        po.band_scale = optarg;
+        break;
       case 'S': bad = gs_opt_choice("--start", optarg, starts, &start); break;
       case 'j': bad = gs_opt_int("--jobs", optarg, 1, SWEEP_MAX_JOBS, &jobs); break;
       case 'h': fputs(kSweepUsage, stdout); return GS_EXIT_OK;
@@ -262,7 +276,7 @@ int gs_cmd_sweep(int argc, char** argv) {
     printf("sweep: %d speeds, each from the guess (%.3f m/s), %d at once\n", n, v0,
            jobs < n ? jobs : n);
     fflush(stdout);
-    rc_up = from_guess(guess, v, n, jobs, dir, nodes, max_time, max_iter);
+    rc_up = from_guess(guess, v, n, jobs, dir, &po);
   } else {
     // the chains: downwards from the guess's speed, upwards from it
     int down[SWEEP_MAX_SPEEDS], up[SWEEP_MAX_SPEEDS], nd = 0, nu = 0;
@@ -275,8 +289,8 @@ int gs_cmd_sweep(int argc, char** argv) {
     fflush(stdout);
     // stop signals reach both chains
     pid_t pid = nd > 0 && nu > 0 ? (pid_t)go_ipopt_fork_forwarded() : -1;
-    if (pid == 0) _exit(chain(guess, v, down, nd, dir, nodes, max_time, max_iter));
-    rc_up = chain(guess, v, up, nu, dir, nodes, max_time, max_iter);
+    if (pid == 0) _exit(chain(guess, v, down, nd, dir, &po));
+    rc_up = chain(guess, v, up, nu, dir, &po);
     if (pid > 0) {
       int st = 0;
       while (waitpid(pid, &st, 0) < 0 && errno == EINTR) {
@@ -284,7 +298,7 @@ int gs_cmd_sweep(int argc, char** argv) {
       go_ipopt_forward_signals_to((long)pid, 0);
       rc_down = WIFEXITED(st) ? WEXITSTATUS(st) : GS_EXIT_FAILURE;
     } else if (nd > 0) {
-      rc_down = chain(guess, v, down, nd, dir, nodes, max_time, max_iter);
+      rc_down = chain(guess, v, down, nd, dir, &po);
     }
   }
 

@@ -6,7 +6,8 @@
 # and double-support nodes) as each summary.json has them. Each speed starts from the guess and
 # its solution is bitwise that of `gaitsim predict` with the same words, in whichever process;
 # --start neighbour chains 1.6 -> 1.8 (and 0.9 down from the guess in the forked process); bad
-# --start, --jobs and a malformed list exit 2. Each solve's polish from its far-from-feasible
+# --start, --jobs, --band-scale and a malformed list exit 2; --band-scale reaches each speed
+# (summary.json, and bitwise predict's solution). Each solve's polish from its far-from-feasible
 # point takes most of the test's minute or two.
 # usage: sweep.sh GAITSIM SOURCE_DIR
 set -u
@@ -89,5 +90,19 @@ check "malformed speeds: exit 2" test $? -eq 2
 check "--start middle: exit 2, one line naming it" test $? -eq 2 -a "$(grep -c -- '--start' err2.txt)" -eq 1
 "$gaitsim" sweep --guess guess --speeds 1 --out sw2 --jobs 9 2>/dev/null
 check "--jobs 9: exit 2" test $? -eq 2
+for scale in 11 -1 x; do
+  "$gaitsim" sweep --guess guess --speeds 1 --out sw2 --band-scale "$scale" 2>err3.txt
+  check "--band-scale $scale: exit 2, one line naming it" \
+    test $? -eq 2 -a "$(grep -c -- '--band-scale' err3.txt)" -eq 1
+done
 check "no sw2 written by the refused commands" test ! -e sw2
+# --band-scale reaches every speed: bitwise gaitsim predict with the same words
+"$gaitsim" sweep --guess guess --speeds 1.6 --out swb --nodes 5 --max-iter 2 --band-scale 1.5 \
+  >/dev/null 2>&1
+"$gaitsim" predict --guess guess --speed 1.6 --out pb16 --nodes 5 --max-iter 2 --threads 1 \
+  --band-scale 1.5 >/dev/null 2>&1
+check "--band-scale 1.5: summary.json band_scale" \
+  grep -q '"band_scale":[[:space:]]*1.5' swb/predict_1.6/summary.json
+check "--band-scale 1.5: bitwise gaitsim predict's variables.sto" \
+  cmp -s swb/predict_1.6/variables.sto pb16/variables.sto
 finish

@@ -111,10 +111,8 @@ int gs_physics_step(const mjModel* m, mjData* d, mjtNum* fT_dot) {
   // MuJoCo resets the state (time included) when it finds a bad acceleration: count those
   int bad_before = d->warning[mjWARN_BADQACC].number;
   mj_step1(m, d);
-  if (gs_tendon_repair(m, d) != 0) {  // a grazing wrap (gs_tendon_paths.h): redo what reads it
-    mj_transmission(m, d);
-    mj_fwdVelocity(m, d);
-  }
+  // a grazing wrap (gs_tendon_paths.h): the velocity stage again, from the recomputed tendons
+  if (gs_tendon_repair(m, d) != 0) mj_fwdVelocity(m, d);
   gs_physics_tendon_force_rates(m, d, fT_dot);
   mj_step2(m, d);
   if (d->warning[mjWARN_BADQACC].number != bad_before) {

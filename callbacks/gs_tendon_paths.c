@@ -124,22 +124,18 @@ int gs_tendon_repair(const mjModel* m, mjData* d) {
   int bad = 0;
   for (int t = 0; t < nt; t++) bad |= !isfinite(d->ten_length[t]);
   d->pstack = mark;
+  mj_transmission(m, d);  // the actuators' lengths and moment arms from the recomputed tendons
   return bad ? -1 : todo;
 }
 
 int gs_fwd_position(const mjModel* m, mjData* d) {
   mj_fwdPosition(m, d);
-  int r = gs_tendon_repair(m, d);
-  if (r != 0) mj_transmission(m, d);
-  return r;
+  return gs_tendon_repair(m, d);
 }
 
 int gs_inverse(const mjModel* m, mjData* d) {
   mj_inverse(m, d);
   int r = gs_tendon_repair(m, d);
-  if (r != 0) {
-    mj_transmission(m, d);
-    mj_inverseSkip(m, d, mjSTAGE_POS, 0);
-  }
+  if (r != 0) mj_inverseSkip(m, d, mjSTAGE_POS, 0);
   return r;
 }

@@ -31,11 +31,12 @@
 // up to 1e-8 of the radius (2e-10 m at 20.9 mm); fifty times that
 #define GS_TENDON_GRAZE_REL 5e-7
 
-// After mj_tendon (kinematics computed): the repair above; geom positions restored. Returns the
-// number of tendons recomputed (0: d untouched), or -1 when one stays non-finite.
+// After mj_tendon and mj_transmission (kinematics computed): the repair above, geom positions
+// restored, and mj_transmission again when a tendon was recomputed. Returns the number of tendons
+// recomputed (0: d untouched), or -1 when one stays non-finite.
 int gs_tendon_repair(const mjModel* m, mjData* d);
 
-// mj_fwdPosition, then, when a tendon was recomputed, mj_transmission. gs_tendon_repair's return.
+// mj_fwdPosition, then gs_tendon_repair; its return.
 int gs_fwd_position(const mjModel* m, mjData* d);
 
 // mj_inverse with gs_fwd_position's position stage: bitwise mj_inverse when no tendon is

@@ -505,8 +505,8 @@ static double metabolic(const go_gait* g, gait_ctx* c, const double* z, double* 
       mj_kinematics(m, d);
       mj_comPos(m, d);
       mj_tendon(m, d);
-      gs_tendon_repair(m, d);
       mj_transmission(m, d);
+      gs_tendon_repair(m, d);
       mju_addToScl(dr, d->actuator_moment, s == 0 ? 1.0 / (2 * eps) : -1.0 / (2 * eps),
                    na * nv);
     }

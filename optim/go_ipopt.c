@@ -254,15 +254,15 @@ typedef struct {
   struct timespec t0;
 } solve_state;
 
-// note a failed evaluation of callback what (Ipopt sees FALSE: a failed derivative ends the solve
-// with Invalid_Number_Detected, a failed function value only shortens the step); the Hessians
-// set no reason of their own, so theirs says only that they failed
-static void note_eval_error(solve_state* s, const char* what) {
-  if (strstr(what, "Hessian"))
-    snprintf(s->eval_error, sizeof(s->eval_error), "%s: failed or non-finite", what);
-  else
-    snprintf(s->eval_error, sizeof(s->eval_error), "%s: %s", what, go_nlp_last_error(s->nlp));
+// note a failed evaluation of callback what, for reason why (Ipopt sees FALSE: a failed
+// derivative ends the solve with Invalid_Number_Detected, a failed function value only shortens
+// the step)
+static void note_eval_error(solve_state* s, const char* what, const char* why) {
+  snprintf(s->eval_error, sizeof(s->eval_error), "%s: %s", what, why);
 }
+
+// the Hessians set no reason of their own
+static const char kHessianFailed[] = "failed or non-finite";
 
 static double elapsed(const struct timespec* t0) {
   struct timespec t;
@@ -279,7 +279,7 @@ static double cpu_now(void) {
 static Bool cb_f(Index n, Number* x, Bool new_x, Number* f, UserDataPtr u) {
   solve_state* s = u;
   if (go_nlp_eval_f(s->nlp, x, f)) {
-    note_eval_error(s, "objective");
+    note_eval_error(s, "objective", go_nlp_last_error(s->nlp));
     return FALSE;
   }
   memcpy(s->xf, x, sizeof(double) * (size_t)n);
@@ -291,7 +291,7 @@ static Bool cb_f(Index n, Number* x, Bool new_x, Number* f, UserDataPtr u) {
 static Bool cb_grad_f(Index n, Number* x, Bool new_x, Number* grad, UserDataPtr u) {
   solve_state* s = u;
   if (go_nlp_eval_grad_f(s->nlp, x, grad)) {
-    note_eval_error(s, "objective gradient");
+    note_eval_error(s, "objective gradient", go_nlp_last_error(s->nlp));
     return FALSE;
   }
   return TRUE;
@@ -300,7 +300,7 @@ static Bool cb_grad_f(Index n, Number* x, Bool new_x, Number* grad, UserDataPtr 
 static Bool cb_g(Index n, Number* x, Bool new_x, Index m, Number* g, UserDataPtr u) {
   solve_state* s = u;
   if (go_nlp_eval_g(s->nlp, x, g)) {
-    note_eval_error(s, "constraints");
+    note_eval_error(s, "constraints", go_nlp_last_error(s->nlp));
     s->have_g = 0;
     return FALSE;
   }
@@ -318,7 +318,7 @@ static Bool cb_jac(Index n, Number* x, Bool new_x, Index m, Index nele, Index* i
     return TRUE;
   }
   if (go_nlp_eval_jac(s->nlp, x, vals)) {
-    note_eval_error(s, "constraint Jacobian");
+    note_eval_error(s, "constraint Jacobian", go_nlp_last_error(s->nlp));
     return FALSE;
   }
   if (s->opts->hess) go_hess_note_jacobian(s->opts->hess, x, vals);
@@ -340,7 +340,7 @@ static Bool cb_h(Index n, Number* x, Bool new_x, Number obj_factor, Index m, Num
       return TRUE;
     }
     if (go_hess_values(s->opts->hess, x, obj_factor, lambda, vals) == 0) return TRUE;
-    note_eval_error(s, "Hessian");
+    note_eval_error(s, "Hessian", kHessianFailed);
     return FALSE;
   }
   if (!s->opts->gauss_newton) return FALSE;
@@ -349,7 +349,7 @@ static Bool cb_h(Index n, Number* x, Bool new_x, Number obj_factor, Index m, Num
     return TRUE;
   }
   if (go_nlp_eval_hess_diag(s->nlp, x, obj_factor, vals) == 0) return TRUE;
-  note_eval_error(s, "Gauss-Newton Hessian");
+  note_eval_error(s, "Gauss-Newton Hessian", kHessianFailed);
   return FALSE;
 }
 

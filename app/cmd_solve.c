@@ -883,6 +883,11 @@ static void predict_summary(const go_gait* g, const double* z, const gsTrackOpti
   // lies within 0.1 % of the band's half-width from its edge, so that the band, not the
   // objective, placed it there; coordinates never at the band are left out
   cJSON_AddNumberToObject(summary, "band_scale", o->band_scale);
+  cJSON* widths = cJSON_AddObjectToObject(summary, "band_half_widths_at_scale_1");
+  cJSON_AddNumberToObject(widths, "rotation_rad", PREDICT_BAND_ROT);
+  cJSON_AddNumberToObject(widths, "translation_m", PREDICT_BAND_TRANS);
+  cJSON_AddNumberToObject(widths, "rotation_speed_rad_per_s", PREDICT_BAND_ROT_SPEED);
+  cJSON_AddNumberToObject(widths, "translation_speed_m_per_s", PREDICT_BAND_TRANS_SPEED);
   cJSON* ba = cJSON_AddObjectToObject(summary, "band_active_nodes");
   const double* bq = band + (size_t)N * L->nz + 1;
   for (int j = 0; j < m->nv; j++) {
@@ -956,9 +961,10 @@ static const char* kPredictUsage =
 // (in two parts: C11 compilers need not take string literals over 4095 characters)
 static const char* kPredictUsageBand =
     "  --band-scale F      factor on the half-widths of eq. 3's band around the guess (20 deg,\n"
-    "                      5 cm, 6 rad/s, 1 m/s; the paper gives none): default 1, 0: no band;\n"
-    "                      summary.json band_active_nodes counts, per coordinate and speed, the\n"
-    "                      nodes the band holds\n"
+    "                      5 cm, 6 rad/s, 1 m/s: summary.json band_half_widths_at_scale_1; the\n"
+    "                      paper gives none): default 1, 0: no band; summary.json\n"
+    "                      band_active_nodes counts, per coordinate and speed, the nodes the\n"
+    "                      band holds\n"
     "  --fallback-rise F   stop when the objective rises by more than the fraction F above the\n"
     "                      lowest one reached at a violation <= " GO_STR(GO_FALLBACK_VIOL)
     ", and restart from the\n"

@@ -1,7 +1,8 @@
 #!/usr/bin/env python3
 """Where a prediction lies against eq. 3's band around a guess (Lin, Walter & Pandy 2018, eq. 3:
-q and qdot within a band around the tracking solution; gaitsim predict's half-widths are 20 deg,
-5 cm, 6 rad/s and 1 m/s, times --band-scale; pelvis_tx itself has no band, its speed has).
+q and qdot within a band around the tracking solution; pelvis_tx itself has no band, its speed
+has). The half-widths are those gaitsim predict wrote in SOLUTION_DIR/summary.json
+(band_half_widths_at_scale_1), times the band scale.
 
 usage: band_excursions.py GUESS_DIR SOLUTION_DIR [--band-scale F] [--model FILE] [--json]
 
@@ -13,7 +14,7 @@ and gives, per coordinate and per speed ("NAME_speed"):
             elsewhere, e.g. restarted from itself);
   largest   the largest distance from the guess (deg, m, deg/s or m/s, as states.sto).
 Only coordinates at the edge or beyond are listed. --band-scale defaults to SOLUTION_DIR's
-summary.json band_scale (else 1); --model to its summary.json model (slide joints from the MJCF).
+summary.json band_scale; --model to its summary.json model (slide joints from the MJCF).
 Markdown table on stdout, or with --json {"band_scale", "at_edge", "beyond", "largest"}.
 Bad input: one line naming the file or option, exit 2.
 """
@@ -27,7 +28,10 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from gs_scriptlib import PrepError, read_json, read_storage  # noqa: E402
 
 DEG = 180 / math.pi
-HALF_WIDTH = {"rot": 0.35 * DEG, "trans": 0.05, "rot_speed": 6.0 * DEG, "trans_speed": 1.0}
+# summary.json's band_half_widths_at_scale_1 keys, and the factor to states.sto's units
+WIDTH_KEYS = {"rot": ("rotation_rad", DEG), "trans": ("translation_m", 1.0),
+              "rot_speed": ("rotation_speed_rad_per_s", DEG),
+              "trans_speed": ("translation_speed_m_per_s", 1.0)}
 EDGE = 1e-3  # "at the edge": within this fraction of the half-width (cmd_solve.c's rule)
 
 
@@ -44,7 +48,21 @@ def slide_joints(model):
     return {j.get("name") for j in root.iter("joint") if j.get("type") == "slide"}
 
 
-def excursions(guess, sol, scale, slides):
+def half_widths(summary, summary_path):
+    """Half-widths at scale 1 in states.sto's units (deg, m, deg/s, m/s), from summary.json."""
+    widths = summary.get("band_half_widths_at_scale_1")
+    if not isinstance(widths, dict):
+        fail(summary_path, "no band_half_widths_at_scale_1 (not a gaitsim predict solution)")
+    out = {}
+    for kind, (key, unit) in WIDTH_KEYS.items():
+        v = widths.get(key)
+        if not isinstance(v, (int, float)) or not v >= 0:
+            fail(summary_path, f"band_half_widths_at_scale_1.{key}: not a number >= 0")
+        out[kind] = v * unit
+    return out
+
+
+def excursions(guess, sol, scale, slides, width):
     """(at_edge, beyond, largest) dicts keyed by coordinate or NAME_speed."""
     _, hg, g = guess
     _, hs, s = sol
@@ -57,7 +75,7 @@ def excursions(guess, sol, scale, slides):
         if coord == "pelvis_tx" and not speed:
             continue
         kind = ("trans" if coord in slides else "rot") + ("_speed" if speed else "")
-        hw = scale * HALF_WIDTH[kind]
+        hw = scale * width[kind]
         if not hw > 0:
             continue
         js, jg = hs.index(name), hg.index(name)
@@ -101,16 +119,18 @@ def main(argv):
     if len(guess[2]) != len(sol[2]):
         fail(sol_dir, f"{len(sol[2])} nodes against the guess's {len(guess[2])}")
     try:
-        scale = float(opts.get("--band-scale", summary.get("band_scale", 1.0)))
-    except ValueError:
-        fail("--band-scale", "not a number")
+        scale = float(opts.get("--band-scale", summary.get("band_scale", "none")))
+    except (TypeError, ValueError):
+        fail("--band-scale" if "--band-scale" in opts else summary_path,
+             "not a number" if "--band-scale" in opts else "no band_scale: give --band-scale")
     if not (0 <= scale <= 10):
         fail("--band-scale", "outside 0-10")
     model = opts.get("--model", summary.get("model"))
     if not model:
         fail(summary_path, "no model named: give --model")
+    width = half_widths(summary, summary_path)
     slides = slide_joints(model)
-    at_edge, beyond, largest = excursions(guess, sol, scale, slides)
+    at_edge, beyond, largest = excursions(guess, sol, scale, slides, width)
     if opts.get("json"):
         print(json.dumps({"band_scale": scale, "at_edge": at_edge, "beyond": beyond,
                           "largest": largest}, indent=1))
@@ -123,7 +143,7 @@ def main(argv):
         coord = key[:-6] if speed else key
         kind = ("trans" if coord in slides else "rot") + ("_speed" if speed else "")
         unit = {"rot": "deg", "trans": "m", "rot_speed": "deg/s", "trans_speed": "m/s"}[kind]
-        print(f"| {key} | {scale * HALF_WIDTH[kind]:.4g} {unit} | {at_edge[key]} | {beyond[key]} "
+        print(f"| {key} | {scale * width[kind]:.4g} {unit} | {at_edge[key]} | {beyond[key]} "
               f"| {largest[key]:.4g} {unit} |")
 
 

@@ -9,7 +9,8 @@
 # pelvis_tx itself has no band, its speed has), none beyond the band, and not empty; against a
 # band narrower than the solve's (x 0.2) some nodes lie beyond; without a band (--band-scale 0)
 # none held; a negative scale or one above 10 is bad usage (exit 2), and so is a scale that is
-# not a number to the script.
+# not a number to the script; the script takes the half-widths from summary.json
+# (band_half_widths_at_scale_1) and names the file when they are missing.
 # usage: band.sh GAITSIM SOURCE_DIR
 set -u
 gaitsim=$1 src=$2
@@ -45,6 +46,22 @@ e = json.load(open('tighter.json'))
 sys.exit(0 if sum(e['beyond'].values()) > 0 else 1)"
 /usr/bin/python3 "$src/scripts/band_excursions.py" track narrow --band-scale x >/dev/null 2>&1
 check "band_excursions.py --band-scale x: exit 2" test $? -eq 2
+check "summary.json: the half-widths at scale 1 (0.35 rad, 5 cm, 6 rad/s, 1 m/s)" \
+  /usr/bin/python3 -c "
+import json, sys
+w = json.load(open('narrow/summary.json'))['band_half_widths_at_scale_1']
+sys.exit(0 if w == {'rotation_rad': 0.35, 'translation_m': 0.05,
+                    'rotation_speed_rad_per_s': 6, 'translation_speed_m_per_s': 1} else 1)"
+mkdir -p nowidths && cp narrow/states.sto nowidths/ && /usr/bin/python3 -c "
+import json
+s = json.load(open('narrow/summary.json'))
+del s['band_half_widths_at_scale_1']
+json.dump(s, open('nowidths/summary.json', 'w'))"
+/usr/bin/python3 "$src/scripts/band_excursions.py" track nowidths >/dev/null 2>nowidths.err
+status=$?
+check "band_excursions.py without the half-widths: exit 2 (got $status)" test "$status" -eq 2
+check "band_excursions.py without the half-widths: one line naming summary.json" \
+  grep -q "nowidths/summary.json: no band_half_widths_at_scale_1" nowidths.err
 "$gaitsim" predict --guess track --model "$model" --speed 1.2 --nodes 20 --max-iter 50 \
   --threads 2 --band-scale 0 --out none >/dev/null 2>&1
 check "no band: band_scale 0, none held" /usr/bin/python3 -c "

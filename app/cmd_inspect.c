@@ -15,6 +15,7 @@
 #include "callbacks/gs_muscle.h"
 #include "callbacks/gs_physics.h"
 #include "callbacks/gs_state.h"
+#include "callbacks/gs_tendon_paths.h"
 
 static const char* kInspectUsage =
     "usage: gaitsim inspect MODEL --pose FILE [--time T] [--activation A]\n\n"
@@ -81,9 +82,9 @@ int gs_cmd_inspect(int argc, char** argv) {
   if (map.nctrl_found == 0) {  // excitations default to the activation
     for (int i = m->nu - m->na; i < m->nu; i++) d->ctrl[i] = d->act[i - (m->nu - m->na)];
   }
-  mj_forward(m, d);
+  gs_forward(m, d);
   gs_physics_equilibrate_tendons(m, d, map.fT_col);  // tendon forces not given
-  mj_forward(m, d);
+  gs_forward(m, d);
   printf("%s at t = %.4f s of %s\n", path, time, pose);
   printf("%-16s %-7s %9s %8s %7s %9s %9s  %s\n", "muscle", "tendon", "lMT (m)", "lM (m)",
          "lM/lopt", "F (N)", "Edot (W)", "moment arms (m)");

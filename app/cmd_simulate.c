@@ -15,6 +15,7 @@
 #include "callbacks/gs_model_info.h"
 #include "callbacks/gs_physics.h"
 #include "callbacks/gs_state.h"
+#include "callbacks/gs_tendon_paths.h"
 #include "io/gs_atomic.h"
 #include "optim/go_ipopt.h"
 
@@ -160,7 +161,7 @@ static int initial_state(const mjModel* m, mjData* d, const gsSimulateOptions* o
   if (slide >= 0) {
     d->qpos[m->jnt_qposadr[slide]] += o->drop * (d->xaxis[3 * slide + 2] > 0 ? 1 : -1);
   }
-  mj_fwdPosition(m, d);
+  gs_fwd_position(m, d);  // tendons finite where a path grazes a wrap geom
   // elastic tendons without a given state: static equilibrium
   gs_physics_equilibrate_tendons(m, d, o->init ? map.fT_col : NULL);
   gs_state_map_free(&map);
@@ -263,7 +264,7 @@ int gs_cmd_simulate(int argc, char** argv) {
       gs_state_apply(m, &excitations, &xmap, excitations.time[0] + d->time - t0, d);
     }
     if (s % every == 0 && row < nrow) {
-      mj_forward(m, d);
+      gs_forward(m, d);  // the recorded row: tendons repaired as in the step
       gs_state_table_set_row(m, d, d->time - t0, &states, row);
       gs_grf_table_set_row(m, d, d->time - t0, &grf, row);
       forces.time[row] = d->time - t0;

@@ -139,3 +139,14 @@ int gs_inverse(const mjModel* m, mjData* d) {
   if (r != 0) mj_inverseSkip(m, d, mjSTAGE_POS, 0);
   return r;
 }
+
+int gs_forward(const mjModel* m, mjData* d) {
+  // the position stage once, repaired (mj_forward twice would warm-start the constraint solver
+  // from the first call's NaN accelerations), then mj_forwardSkip's position-stage sensors and
+  // energy and the rest: mj_forward's own sequence (engine_forward.c)
+  int r = gs_fwd_position(m, d);
+  mj_sensorPos(m, d);
+  if (mjENABLED(mjENBL_ENERGY)) mj_energyPos(m, d);
+  mj_forwardSkip(m, d, mjSTAGE_POS, 0);
+  return r;
+}

@@ -43,4 +43,9 @@ int gs_fwd_position(const mjModel* m, mjData* d);
 // recomputed; else the repaired position stage and mj_inverseSkip(mjSTAGE_POS). The same return.
 int gs_inverse(const mjModel* m, mjData* d);
 
+// mj_forward with gs_fwd_position's position stage (then mj_forward's position-stage sensors and
+// energy, and mj_forwardSkip(mjSTAGE_POS)): bitwise mj_forward when no tendon is recomputed.
+// gs_fwd_position's return.
+int gs_forward(const mjModel* m, mjData* d);
+
 #endif  // GAITSIM_CALLBACKS_GS_TENDON_PATHS_H_

@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "callbacks/gs_tendon_paths.h"
 #include "io/gs_atomic.h"
 #include "render/gr_image.h"
 
@@ -414,6 +415,7 @@ void gr_renderer_frame(grRenderer* r, const grMotion* mo, double t, unsigned cha
   mj_comPos(m, d);
   mj_camlight(m, d);
   mj_tendon(m, d);
+  gs_tendon_repair(m, d);  // a path grazing a wrap geom drawn straight, not NaN or the far side
   place_camera(r);
   mjv_updateScene(m, d, &r->opt, NULL, &r->cam, mjCAT_ALL, &r->scn);
   place_lights(r);

@@ -13,7 +13,10 @@
 //    MuJoCo gives NaN or the far side of the cylinder (>= 5 mm longer) at some, the repair at none,
 //    and the repaired length's second difference stays below TOL_SECOND (a straight line's
 //    rounding; MuJoCo's far side jumps 31 mm);
-//  - gs_inverse equals mj_inverse bitwise at a pose without a graze (qpos0 with the hip flexed).
+//  - gs_forward at the graze: the repaired length, and finite accelerations where mj_forward's
+//    are not (simulate's recorded rows, inspect);
+//  - gs_inverse and gs_forward equal mj_inverse and mj_forward bitwise at a pose without a graze
+//    (qpos0 with the hip flexed).
 #include <math.h>
 #include <mujoco/mujoco.h>
 #include <stdio.h>
@@ -92,6 +95,22 @@ int main(void) {
   lm = d->ten_length[t];
   EXPECT_NEAR((lp - lm) / (2 * FD_STEP), arm, TOL_ARM);
 
+  // gs_forward at the graze: the repaired tendon of gs_fwd_position, and accelerations finite
+  // where mj_forward's are not
+  double repaired_len = 0;
+  set_pose(m, d, add, 0);
+  gs_fwd_position(m, d);
+  repaired_len = d->ten_length[t];
+  set_pose(m, raw, add, 0);
+  mj_forward(m, raw);
+  set_pose(m, d, add, 0);
+  EXPECT_EQ_INT(1, gs_forward(m, d));
+  EXPECT_TRUE(d->ten_length[t] == repaired_len);
+  int raw_finite = 1, finite = 1;
+  for (int j = 0; j < m->nv; j++) raw_finite &= isfinite(raw->qacc[j]), finite &= isfinite(d->qacc[j]);
+  EXPECT_TRUE(!raw_finite);
+  EXPECT_TRUE(finite);
+
   // across the graze
   const double steps[3] = {1e-11, 1e-9, 1e-7};
   for (int s = 0; s < 3; s++) {
@@ -127,6 +146,11 @@ int main(void) {
   EXPECT_EQ_INT(0, gs_inverse(m, d));
   EXPECT_TRUE(!memcmp(raw->qfrc_inverse, d->qfrc_inverse, sizeof(mjtNum) * m->nv));
   EXPECT_TRUE(!memcmp(raw->actuator_length, d->actuator_length, sizeof(mjtNum) * m->nu));
+  // no graze: gs_forward is mj_forward
+  mj_forward(m, raw);
+  EXPECT_EQ_INT(0, gs_forward(m, d));
+  EXPECT_TRUE(!memcmp(raw->qacc, d->qacc, sizeof(mjtNum) * m->nv));
+  EXPECT_TRUE(!memcmp(raw->actuator_force, d->actuator_force, sizeof(mjtNum) * m->nu));
 
   mj_deleteData(raw);
   mj_deleteData(d);

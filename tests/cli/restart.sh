@@ -9,10 +9,12 @@
 # (each after more iterations than the one before, each from an iteration no later than its stop,
 # with the objective and violation of the best iterate it started from, violation <= 1e-3: the
 # best-iterate ranking's limit, go_ipopt_opts.best_viol_tol), the iterations of all three solves
-# summed, the polished result feasible to 1e-6, the progress naming both restarts, and the exit
-# status the final status calls for: 3 with "fell back from the solution it had reached" (the
-# third solve fell back too), 0 with a converged status; --fallback-rise with a negative value is
-# a usage error (exit 2).
+# summed, the polished result feasible to 1e-6 and less violated than the point it was polished
+# from (summary.json polish.violation_before: the settled solve's best iterate, not Ipopt's last
+# point; equal to the written violation if the polish was not used), the progress naming both
+# restarts, and the exit status the final status calls for: 3 with "fell back from the solution
+# it had reached" (the third solve fell back too), 0 with a converged status; --fallback-rise
+# with a negative value is a usage error (exit 2).
 # usage: restart.sh GAITSIM SOURCE_DIR
 set -u
 gaitsim=$1 src=$2
@@ -45,6 +47,19 @@ ok = (len(r) == 2
 if not ok:
     print(json.dumps({k: s.get(k) for k in ("status", "iterations", "restarts", "max_violation")}),
           file=sys.stderr)
+sys.exit(0 if ok else 1)
+PY
+check "polish: violation_before is that of the point polished (the settled best iterate)" \
+  /usr/bin/python3 - pred/summary.json <<'PY'
+import json, sys
+s = json.load(open(sys.argv[1]))
+p = s["polish"]
+v0, v = p["violation_before"], s["max_violation"]
+# not used: the point written is the one polished, so its violation is violation_before;
+# used: the polished point, less violated
+ok = abs(v - v0) <= 1e-6 * v0 if not p["used"] else v < v0
+if not ok:
+    print(json.dumps({"polish": p, "max_violation": v}), file=sys.stderr)
 sys.exit(0 if ok else 1)
 PY
 "$gaitsim" predict --guess track --speed 1.2 --out x --fallback-rise -1 >/dev/null 2>&1

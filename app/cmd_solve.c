@@ -911,18 +911,17 @@ static const char* kPredictUsage =
     "Predictive solve of one stride at mean speed V (m/s), no data tracked (Lin, Walter & Pandy\n"
     "2018): minimise the cost of transport (smooth Umberger 2010 metabolic energy / (mass x\n"
     "distance)) with free stride time, periodic but for pelvis_tx, q and qdot within a band\n"
-    "around the guess (eq. 3: 20 deg, 5 cm, 6 rad/s, 1 m/s), started from the solution in\n"
-    "TRACK_DIR (its forward progression rescaled to V). Writes the files of `gaitsim track`;\n"
-    "summary.json adds stride time and length, their change from the guess, the cost of\n"
-    "transport and peak triceps surae excitations. L-BFGS (Ipopt's limited-memory Hessian)\n"
-    "stops at Ipopt's optimal solution, at its acceptable level (" GO_STR(GO_SETTLE_ITER)
-    " consecutive iterations at a\n"
-    "violation <= " GO_STR(GO_PREDICT_SETTLE_VIOL) ", the objective changing <= "
-    GO_STR(GO_PREDICT_SETTLE_REL) " relative per iteration), or once " GO_STR(GO_SETTLE_ITER)
-    " of the\n"
-    "last 2 x " GO_STR(GO_SETTLE_ITER) " iterations meet it (status \"objective settled\"); "
-    "then the polish onto the\n"
-    "dynamics. Exit status 3 when the solver stopped short.\n\n"
+    "around the guess (eq. 3: 30 deg, 7.5 cm, 9 rad/s, 1.5 m/s by default, see --band-scale),\n"
+    "started from the solution in TRACK_DIR (its forward progression rescaled to V). Writes the\n"
+    "files of `gaitsim track`; summary.json adds stride time and length, their change from the\n"
+    "guess, the cost of transport and peak triceps surae excitations. L-BFGS (Ipopt's\n"
+    "limited-memory Hessian) stops at Ipopt's optimal solution, at its acceptable level\n"
+    "(" GO_STR(GO_SETTLE_ITER) " consecutive iterations at a violation <= " GO_STR(GO_PREDICT_SETTLE_VIOL)
+    ", the objective changing\n"
+    "<= " GO_STR(GO_PREDICT_SETTLE_REL) " relative per iteration), or once " GO_STR(GO_SETTLE_ITER)
+    " of the last 2 x " GO_STR(GO_SETTLE_ITER) " iterations meet it\n"
+    "(status \"objective settled\"); then the polish onto the dynamics. Exit status 3 when the\n"
+    "solver stopped short.\n\n"
     "  --model FILE        MJCF model (default: the one TRACK_DIR/summary.json names, else\n"
     "                      mjmodels/jw_fullbody_knee6.xml)\n"
     "  --nodes N           collocation nodes (default: the guess's, TRACK_DIR/summary.json\n"
@@ -962,7 +961,7 @@ static const char* kPredictUsage =
 static const char* kPredictUsageBand =
     "  --band-scale F      factor on the half-widths of eq. 3's band around the guess (20 deg,\n"
     "                      5 cm, 6 rad/s, 1 m/s: summary.json band_half_widths_at_scale_1; the\n"
-    "                      paper gives none): default 1, 0: no band; summary.json\n"
+    "                      paper gives none): default " GO_STR(GO_PREDICT_BAND_SCALE) ", 0: no band; summary.json\n"
     "                      band_active_nodes counts, per coordinate and speed, the nodes the\n"
     "                      band holds\n"
     "  --fallback-rise F   stop when the objective rises by more than the fraction F above the\n"
@@ -1005,7 +1004,7 @@ int gs_cmd_predict(int argc, char** argv) {
   o.metabolic_smoothing = GO_PREDICT_METABOLIC_SMOOTHING;
   o.fibre_bounds = 1;
   o.min_vgrf = GO_PREDICT_MIN_VGRF;
-  o.band_scale = 1;
+  o.band_scale = GO_PREDICT_BAND_SCALE;
   optind = 1;
   opterr = 0;
   int c, bad = 0, model_given = 0, nodes_given = 0;

@@ -55,7 +55,7 @@ static const char* kSweepUsage =
     "  --max-iter N    Ipopt iteration limit of each solve (default " GO_STR(GO_MAX_ITER)
     ")\n"
     "  --band-scale F  factor on the half-widths of eq. 3's band around the guess, as gaitsim\n"
-    "                  predict (default 1; 0 removes the band; 0-10)\n";
+    "                  predict (default " GO_STR(GO_PREDICT_BAND_SCALE) "; 0 removes the band; 0-10)\n";
 
 // the guess's mean speed (summary.json speed_mps), or NAN
 static double guess_speed(const char* dir) {
@@ -220,7 +220,7 @@ int gs_cmd_sweep(int argc, char** argv) {
   int start = 0, jobs = SWEEP_DEFAULT_JOBS;
   const char *guess = NULL, *dir = NULL;
   sweep_predict_opts po = {NULL, NULL, GO_STR(GO_MAX_ITER), NULL};
-  double band_scale = 1;
+  double band_scale = GO_PREDICT_BAND_SCALE;
   double v[SWEEP_MAX_SPEEDS];
   int n = -1, c, bad = 0;
   optind = 1;

@@ -20,9 +20,9 @@
 #define GO_MAX_ITER 2500           // each prediction: gaitsim predict, each speed of sweep and of
                                    // run's main job (--max-iter). An iteration budget, not a time
                                    // limit, so results do not depend on the load of the machine;
-                                   // at 80 nodes the main job's predictions stop after 411
-                                   // (0.8 m/s) and 690 (2.0 m/s) iterations; other starts took
-                                   // up to 1617 (docs/BENCHMARKS.md)
+                                   // at 80 nodes the main job's predictions stop after 971
+                                   // (0.8 m/s) and 788 (2.0 m/s) iterations; other starts took
+                                   // up to 1807 (docs/BENCHMARKS.md)
 #define GO_MAX_ITER_TRACK 60       // track's main solve, Gauss-Newton from the trial's guess at
                                    // barrier GO_GN_MU_INIT, before the refinement (--max-iter).
                                    // At N = 80 it brings the violation from 182 to about 0.1 at
@@ -149,5 +149,13 @@
 // at 2 nodes, lowest summed force 0.22 BW). Human walking keeps it above about 0.4 BW even at
 // 2 m/s (docs/BENCHMARKS.md, "Walking: a floor on the vertical ground reaction")
 #define GO_PREDICT_MIN_VGRF 0.2
+// gaitsim predict's factor on the half-widths of eq. 3's band around the guess (-; at 1: 20 deg,
+// 5 cm, 6 rad/s, 1 m/s, app/cmd_solve.c PREDICT_BAND_*; the paper gives none). On the 80-node
+// sweep from the tracking solution at 0.8-2.0 m/s: at 1 every speed settled but the band held the
+// predictions at its edge, the cost of transport was not monotonic in speed (1.6 m/s above 1.4
+// and 1.8) and the left knee peaked at 4.7 BW at 2.0 m/s; at 1.5 every speed settles 3-12 % lower
+// in the objective, the cost falls smoothly with speed and both knees peak at <= 3.1 BW
+// (docs/BENCHMARKS.md, "Eq. 3's band x 1.5, the default")
+#define GO_PREDICT_BAND_SCALE 1.5
 
 #endif  // GAITSIM_OPTIM_GO_DEFAULTS_H_

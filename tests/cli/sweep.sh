@@ -96,13 +96,16 @@ for scale in 11 -1 x; do
     test $? -eq 2 -a "$(grep -c -- '--band-scale' err3.txt)" -eq 1
 done
 check "no sw2 written by the refused commands" test ! -e sw2
-# --band-scale reaches every speed: bitwise gaitsim predict with the same words
-"$gaitsim" sweep --guess guess --speeds 1.6 --out swb --nodes 5 --max-iter 2 --band-scale 1.5 \
+# --band-scale reaches every speed (a scale other than the default 1.5): bitwise gaitsim predict
+# with the same words; without it, predict's default
+"$gaitsim" sweep --guess guess --speeds 1.6 --out swb --nodes 5 --max-iter 2 --band-scale 0.8 \
   >/dev/null 2>&1
 "$gaitsim" predict --guess guess --speed 1.6 --out pb16 --nodes 5 --max-iter 2 --threads 1 \
-  --band-scale 1.5 >/dev/null 2>&1
-check "--band-scale 1.5: summary.json band_scale" \
-  grep -q '"band_scale":[[:space:]]*1.5' swb/predict_1.6/summary.json
-check "--band-scale 1.5: bitwise gaitsim predict's variables.sto" \
+  --band-scale 0.8 >/dev/null 2>&1
+check "--band-scale 0.8: summary.json band_scale" \
+  grep -q '"band_scale":[[:space:]]*0.8' swb/predict_1.6/summary.json
+check "--band-scale 0.8: bitwise gaitsim predict's variables.sto" \
   cmp -s swb/predict_1.6/variables.sto pb16/variables.sto
+check "no --band-scale: the default 1.5 (summary.json band_scale)" \
+  grep -q '"band_scale":[[:space:]]*1.5' sw/predict_1.6/summary.json
 finish

@@ -154,8 +154,9 @@
 // sweep from the tracking solution at 0.8-2.0 m/s: at 1 every speed settled but the band held the
 // predictions at its edge, the cost of transport was not monotonic in speed (1.6 m/s above 1.4
 // and 1.8) and the left knee peaked at 4.7 BW at 2.0 m/s; at 1.5 every speed settles 3-12 % lower
-// in the objective, the cost falls smoothly with speed and both knees peak at <= 3.1 BW
-// (docs/BENCHMARKS.md, "Eq. 3's band x 1.5, the default")
+// in the objective, the cost falls steadily to 1.8 m/s, both knees peak at <= 3.1 BW, though
+// the vertical GRF peaks at 2.0 BW at 2.0 m/s (1.6 at x 1) (docs/BENCHMARKS.md, "Eq. 3's band
+// x 1.5, the default")
 #define GO_PREDICT_BAND_SCALE 1.5
 
 #endif  // GAITSIM_OPTIM_GO_DEFAULTS_H_

@@ -1,6 +1,7 @@
-// test_ipopt_glue.c: the Ipopt glue's stopping rules, best iterate, option handling, and that a
-// ./ipopt.opt in the working directory is ignored. Problem: the minimum-effort double integrator
-// (x'' = u, x: 0 -> 1 at rest, T = 1, N = 21).
+// test_ipopt_glue.c: the Ipopt glue's stopping rules, best iterate and its ranking (the polish's
+// by violation alone), option handling, and that a ./ipopt.opt in the working directory is
+// ignored. Problem: the minimum-effort double integrator (x'' = u, x: 0 -> 1 at rest, T = 1,
+// N = 21).
 #define _POSIX_C_SOURCE 200809L
 #include <math.h>
 #include <signal.h>
@@ -311,6 +312,14 @@ int main(void) {
   solve(nlp, &o, z, NULL, NULL, &r, &rc, err);
   EXPECT_EQ_INT(GO_SOLVE_SUCCESS, r.status);
   EXPECT_EQ_INT(0, (int)strlen(r.eval_error));
+
+  // the best-iterate ranking: below best_viol_tol the lower objective wins, so a polish (whose
+  // objective, the distance from its start, is 0 at the start) ranks with best_viol_tol 0,
+  // by violation alone (go_solve.c set_polish)
+  EXPECT_TRUE(!go_ipopt_point_better(7e-6, 7e-8, 0.0, 2.6e-4, 1e-3));
+  EXPECT_TRUE(go_ipopt_point_better(7e-6, 7e-8, 0.0, 2.6e-4, 0.0));
+  EXPECT_TRUE(!go_ipopt_point_better(0.0, 2.6e-4, 7e-6, 7e-8, 0.0));
+  EXPECT_TRUE(!go_ipopt_point_better(NAN, 1e-9, 0.0, 2.6e-4, 0.0));
 
   // every status has a text
   for (int s = GO_SOLVE_SUCCESS; s <= GO_SOLVE_INTERNAL_ERROR; s++)

@@ -911,13 +911,14 @@ static const char* kPredictUsage =
     "Predictive solve of one stride at mean speed V (m/s), no data tracked (Lin, Walter & Pandy\n"
     "2018): minimise the cost of transport (smooth Umberger 2010 metabolic energy / (mass x\n"
     "distance)) with free stride time, periodic but for pelvis_tx, q and qdot within a band\n"
-    "around the guess (eq. 3: 30 deg, 7.5 cm, 9 rad/s, 1.5 m/s by default, see --band-scale),\n"
+    "around the guess (eq. 3: 20 deg, 5 cm, 6 rad/s, 1 m/s, times --band-scale, default "
+    GO_STR(GO_PREDICT_BAND_SCALE) "),\n"
     "started from the solution in TRACK_DIR (its forward progression rescaled to V). Writes the\n"
     "files of `gaitsim track`; summary.json adds stride time and length, their change from the\n"
     "guess, the cost of transport and peak triceps surae excitations. L-BFGS (Ipopt's\n"
     "limited-memory Hessian) stops at Ipopt's optimal solution, at its acceptable level\n"
-    "(" GO_STR(GO_SETTLE_ITER) " consecutive iterations at a violation <= " GO_STR(GO_PREDICT_SETTLE_VIOL)
-    ", the objective changing\n"
+    "(" GO_STR(GO_SETTLE_ITER) " consecutive iterations at a violation <= "
+    GO_STR(GO_PREDICT_SETTLE_VIOL) ", the objective changing\n"
     "<= " GO_STR(GO_PREDICT_SETTLE_REL) " relative per iteration), or once " GO_STR(GO_SETTLE_ITER)
     " of the last 2 x " GO_STR(GO_SETTLE_ITER) " iterations meet it\n"
     "(status \"objective settled\"); then the polish onto the dynamics. Exit status 3 when the\n"
@@ -961,7 +962,8 @@ static const char* kPredictUsage =
 static const char* kPredictUsageBand =
     "  --band-scale F      factor on the half-widths of eq. 3's band around the guess (20 deg,\n"
     "                      5 cm, 6 rad/s, 1 m/s: summary.json band_half_widths_at_scale_1; the\n"
-    "                      paper gives none): default " GO_STR(GO_PREDICT_BAND_SCALE) ", 0: no band; summary.json\n"
+    "                      paper gives none): default " GO_STR(GO_PREDICT_BAND_SCALE)
+    ", 0: no band; summary.json\n"
     "                      band_active_nodes counts, per coordinate and speed, the nodes the\n"
     "                      band holds\n"
     "  --fallback-rise F   stop when the objective rises by more than the fraction F above the\n"

@@ -55,7 +55,8 @@ static const char* kSweepUsage =
     "  --max-iter N    Ipopt iteration limit of each solve (default " GO_STR(GO_MAX_ITER)
     ")\n"
     "  --band-scale F  factor on the half-widths of eq. 3's band around the guess, as gaitsim\n"
-    "                  predict (default " GO_STR(GO_PREDICT_BAND_SCALE) "; 0 removes the band; 0-10)\n";
+    "                  predict (default " GO_STR(GO_PREDICT_BAND_SCALE)
+    "; 0 removes the band; 0-10)\n";
 
 // the guess's mean speed (summary.json speed_mps), or NAN
 static double guess_speed(const char* dir) {

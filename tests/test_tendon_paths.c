@@ -107,7 +107,10 @@ int main(void) {
   EXPECT_EQ_INT(1, gs_forward(m, d));
   EXPECT_TRUE(d->ten_length[t] == repaired_len);
   int raw_finite = 1, finite = 1;
-  for (int j = 0; j < m->nv; j++) raw_finite &= isfinite(raw->qacc[j]), finite &= isfinite(d->qacc[j]);
+  for (int j = 0; j < m->nv; j++) {
+    raw_finite &= isfinite(raw->qacc[j]);
+    finite &= isfinite(d->qacc[j]);
+  }
   EXPECT_TRUE(!raw_finite);
   EXPECT_TRUE(finite);
 

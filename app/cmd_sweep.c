@@ -106,7 +106,7 @@ static int solve_one(const char* guess, double v, const char* out, const sweep_p
   FILE* lf = fopen(log, "w");
   if (lf) dup2(fileno(lf), 2);
   // --nodes, --max-time and --band-scale only when given (predict then takes the guess's node
-  // count, no time limit, the band x 1)
+  // count, no time limit, its default band)
   char* argv[18] = {"predict", "--guess", (char*)guess, "--speed", speed, "--out", (char*)out,
                     "--threads", "1", "--max-iter", (char*)po->max_iter};
   int argc = 11;

@@ -183,10 +183,11 @@ static int set_start_near_solution(go_ipopt_opts* ro, char* err, int errsz) {
 
 // Ipopt options of the feasibility polish: Gauss-Newton (exact for the proximal goal), tol 1e-6,
 // violation 1e-8, the best iterate ranked by violation alone, starting at the point itself: a
-// small barrier, the point barely pushed off its bounds. The barrier's pull mu / s on a variable pushed 1e-8 off its bound must stay below the
-// proximal term's: with mu 1e-6 (100 there) the polish of a prediction at 2.0 m/s, whose
-// activations sit at their 0.001 bound, wandered for 200 iterations at 2e-5 - 1e-3; with 1e-9 it
-// reached 1.6e-9 in 7 (docs/BENCHMARKS.md, "The acceptable level at 1e-4")
+// small barrier, the point barely pushed off its bounds. The barrier's pull mu / s on a variable
+// pushed 1e-8 off its bound must stay below the proximal term's: with mu 1e-6 (100 there) the
+// polish of a prediction at 2.0 m/s, whose activations sit at their 0.001 bound, wandered for 200
+// iterations at 2e-5 - 1e-3; with 1e-9 it reached 1.6e-9 in 7 (docs/BENCHMARKS.md, "The
+// acceptable level at 1e-4")
 static int set_polish(go_ipopt_opts* po, char* err, int errsz) {
   static const char* kv[][2] = {{"tol", "1e-6"},        {"constr_viol_tol", "1e-8"},
                                 {"mu_init", "1e-9"},    {"bound_push", "1e-8"},

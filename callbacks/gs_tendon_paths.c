@@ -133,20 +133,24 @@ int gs_fwd_position(const mjModel* m, mjData* d) {
   return gs_tendon_repair(m, d);
 }
 
+// the repaired position stage, then the position-stage sensors and energy that mj_forwardSkip
+// and mj_inverseSkip leave out when told to skip it: their own sequence, the position stage done
+// once (mj_forward twice would also warm-start the constraint solver from NaN accelerations)
+static int position_stage(const mjModel* m, mjData* d) {
+  int r = gs_fwd_position(m, d);
+  mj_sensorPos(m, d);
+  if (mjENABLED(mjENBL_ENERGY)) mj_energyPos(m, d);
+  return r;
+}
+
 int gs_inverse(const mjModel* m, mjData* d) {
-  mj_inverse(m, d);
-  int r = gs_tendon_repair(m, d);
-  if (r != 0) mj_inverseSkip(m, d, mjSTAGE_POS, 0);
+  int r = position_stage(m, d);
+  mj_inverseSkip(m, d, mjSTAGE_POS, 0);
   return r;
 }
 
 int gs_forward(const mjModel* m, mjData* d) {
-  // the position stage once, repaired (mj_forward twice would warm-start the constraint solver
-  // from the first call's NaN accelerations), then mj_forwardSkip's position-stage sensors and
-  // energy and the rest: mj_forward's own sequence (engine_forward.c)
-  int r = gs_fwd_position(m, d);
-  mj_sensorPos(m, d);
-  if (mjENABLED(mjENBL_ENERGY)) mj_energyPos(m, d);
+  int r = position_stage(m, d);
   mj_forwardSkip(m, d, mjSTAGE_POS, 0);
   return r;
 }

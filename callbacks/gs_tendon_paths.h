@@ -39,8 +39,9 @@ int gs_tendon_repair(const mjModel* m, mjData* d);
 // mj_fwdPosition, then gs_tendon_repair; its return.
 int gs_fwd_position(const mjModel* m, mjData* d);
 
-// mj_inverse with gs_fwd_position's position stage: bitwise mj_inverse when no tendon is
-// recomputed; else the repaired position stage and mj_inverseSkip(mjSTAGE_POS). The same return.
+// mj_inverse with gs_fwd_position's position stage (then mj_inverse's position-stage sensors and
+// energy, and mj_inverseSkip(mjSTAGE_POS)): bitwise mj_inverse when no tendon is recomputed.
+// gs_fwd_position's return.
 int gs_inverse(const mjModel* m, mjData* d);
 
 // mj_forward with gs_fwd_position's position stage (then mj_forward's position-stage sensors and

@@ -14,7 +14,8 @@
 //    and the repaired length's second difference stays below TOL_SECOND (a straight line's
 //    rounding; MuJoCo's far side jumps 31 mm);
 //  - gs_forward at the graze: the repaired length, and finite accelerations where mj_forward's
-//    are not (simulate's recorded rows, inspect);
+//    are not (simulate's recorded rows, inspect); gs_inverse there: the repaired length and the
+//    actuator's length from it, where mj_inverse's is NaN;
 //  - gs_inverse and gs_forward equal mj_inverse and mj_forward bitwise at a pose without a graze
 //    (qpos0 with the hip flexed).
 #include <math.h>
@@ -113,6 +114,13 @@ int main(void) {
   }
   EXPECT_TRUE(!raw_finite);
   EXPECT_TRUE(finite);
+  // gs_inverse at the graze: the same repaired tendon, and the actuator's length from it
+  set_pose(m, raw, add, 0);
+  mj_inverse(m, raw);
+  set_pose(m, d, add, 0);
+  EXPECT_EQ_INT(1, gs_inverse(m, d));
+  EXPECT_TRUE(!isfinite(raw->actuator_length[t]));
+  EXPECT_TRUE(d->ten_length[t] == repaired_len && d->actuator_length[t] == repaired_len);
 
   // across the graze
   const double steps[3] = {1e-11, 1e-9, 1e-7};

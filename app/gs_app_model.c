@@ -11,6 +11,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "callbacks/gs_coupling.h"
 #include "callbacks/gs_mujoco.h"
 #include "callbacks/gs_physics.h"
 #include "callbacks/gs_state.h"
@@ -221,6 +222,7 @@ int gs_app_require_coordinates(const mjModel* m, const gsTable* t, const char* p
     total++;
     const char* name = mj_id2name(m, mjOBJ_JOINT, j);
     if (name && gs_table_column(t, name) >= 0) continue;
+    if (gs_coupling_joint_follows(m, j)) continue;  // follows its driver (gs_state_apply)
     if (missing < 6 && len < sizeof(list)) {
       len += (size_t)snprintf(list + len, sizeof(list) - len, "%s%s", missing ? ", " : "",
                               name ? name : "(unnamed)");

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "callbacks/gs_activation.h"
+#include "callbacks/gs_coupling.h"
 #include "callbacks/gs_knee.h"
 #include "callbacks/gs_model_info.h"
 #include "callbacks/gs_model_layout.h"
@@ -201,6 +202,7 @@ void gs_physics_foot_grf(const mjModel* m, const mjData* d, int side, double fn_
 static void gs_passive_callback(const mjModel* m, mjData* d) {
   gs_physics_contact_passive(m, d);
   gs_knee_passive(m, d, NULL);
+  gs_coupling_passive(m, d);
 }
 
 int gs_physics_prepare(mjModel* m, char* err, int errsz) {
@@ -249,6 +251,8 @@ int gs_physics_prepare(mjModel* m, char* err, int errsz) {
   if (m->nuserdata < GS_USERDATA_SIZE(m)) {
     m->nuserdata = GS_USERDATA_SIZE(m);
   }
+  // coordinate couplings (the right patella's): held by mjcb_passive, not by MuJoCo's solver
+  if (gs_coupling_adopt(m, err, errsz) < 0) return -1;
   // implant knee: numerics checked and cached once here, so that mjcb_passive finds them by the
   // model pointer instead of by name on every call (gs_knee_register; no-op for other models)
   char why[256];

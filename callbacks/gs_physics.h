@@ -6,7 +6,9 @@
 //   mjcb_act_gain   Hill muscle-tendon force (gs_muscle.h): rigid tendons from fibre kinematics,
 //   mjcb_act_bias   elastic tendons from the normalised tendon force state in d->userdata
 //   mjcb_passive    smooth Hunt-Crossley foot-ground contact of every contact sphere
-//                   (gs_contact.h), applied to qfrc_passive; MuJoCo's own contacts are disabled
+//                   (gs_contact.h), applied to qfrc_passive; MuJoCo's own contacts are disabled;
+//                   the implant knee (gs_knee.h); coordinate couplings written as MJCF joint
+//                   equalities, held by a stiff spring (gs_coupling.h)
 // Callbacks are pure functions of (m, d, i): every parameter comes from the model
 // (gs_model_layout.h), every per-evaluation state from d (d->userdata). They are thread-safe with
 // one mjData per thread.
@@ -27,7 +29,8 @@
 #define GS_USERDATA_SIZE(m) ((m)->nu)
 
 // Switch model m to gaitsim's physics: gaitsim muscles get user gain, bias and dynamics; MuJoCo's
-// contact solver is disabled (the spheres become ours); nuserdata grows to GS_USERDATA_SIZE.
+// contact solver is disabled (the spheres become ours); active joint equalities become
+// gaitsim's couplings (gs_coupling_adopt); nuserdata grows to GS_USERDATA_SIZE.
 // Checks every muscle's and contact sphere's parameters. A model with implant-knee numerics
 // (gs_knee_*) has them checked and registered once here (gs_knee.h), so the passive callback
 // does no name look-ups; inconsistent numerics fail. Call before mj_makeData. Returns 0, or -1

@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "callbacks/gs_coupling.h"
 #include "callbacks/gs_model_info.h"
 #include "callbacks/gs_physics.h"
 
@@ -133,6 +134,9 @@ void gs_state_apply(const mjModel* m, const gsTable* t, const gsStateMap* map, d
     if (map->fT_col[i] >= 0) d->userdata[i] = gs_table_value_at(t, map->fT_col[i], time);
     if (map->ctrl_col[i] >= 0) d->ctrl[i] = gs_table_value_at(t, map->ctrl_col[i], time);
   }
+  // coupled coordinates the table lacks (a trial's coordinates have no patella) follow their
+  // driver (gs_coupling.h)
+  gs_coupling_follow(m, d->qpos, d->qvel, map->qpos_col, map->qvel_col);
 }
 
 int gs_state_table_create(const mjModel* m, int nrow, gsTable* t, char* err, int errsz) {

@@ -8,6 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "callbacks/gs_coupling.h"
 #include "callbacks/gs_state.h"
 #include "io/gs_atomic.h"
 #include "io/gs_storage.h"
@@ -85,7 +86,8 @@ static void put_numbers(FILE* f, const char* name, const double* v, int n) {
 static int missing_coordinate(const mjModel* m, const gsStateMap* map) {
   for (int j = 0; j < m->njnt; j++) {
     int type = m->jnt_type[j];
-    if ((type == mjJNT_HINGE || type == mjJNT_SLIDE) && map->qpos_col[m->jnt_qposadr[j]] < 0) {
+    if ((type == mjJNT_HINGE || type == mjJNT_SLIDE) && map->qpos_col[m->jnt_qposadr[j]] < 0 &&
+        !gs_coupling_joint_follows(m, j)) {  // a follower takes its driver's (gs_state_apply)
       return j;
     }
   }

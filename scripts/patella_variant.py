@@ -1,0 +1,151 @@
+#!/usr/bin/python3
+"""Write a variant of a JW model in which the right patella follows the femoral component.
+
+usage: scripts/patella_variant.py MODEL OUT
+
+MODEL is mjmodels/jw_fullbody_knee6.xml (or jw_fullbody.xml); OUT the variant, written atomically.
+The model's meshdir is relative: put OUT in mjmodels/, or beside a link named meshes to
+mjmodels/meshes. Exit 1 with one line naming the file when MODEL cannot be read or is not a JW
+model with the patella on tibial_tray; exit 2 on wrong usage. In the committed
+model the patella is a jointless child of tibial_tray: exact for knee_flexion, but when the
+knee's secondary coordinates move, the patella moves with the tibia, so the quadriceps pull on
+the tibia along the quadriceps tendon (mjmodels/README.md, "Patellae"). JW's .osim instead
+couples the patella to the femoral component: patfem_flexion = knee_flexion + pi/2 about the same
+femoral axis. The variant writes exactly that: the patella body (with its sites and wrap
+cylinder) becomes a child of femoral_component with a hinge patfem_flexion (ref pi/2) on
+knee_flexion's axis and anchor at the default pose, and an <equality><joint> couples it to
+knee_flexion (polycoef 0 1 0 0 0); gaitsim holds the coupling with a stiff spring
+(callbacks/gs_coupling.h). At every default-pose the patella sits where it did, so lengths and
+flexion moment arms are unchanged; the secondary moment arms and pull directions of recfem,
+vasint, vaslat and vasmed become the .osim's. The standing keyframe gains patfem_flexion = pi/2.
+
+The variant is a measurement (docs/BENCHMARKS.md, "The patella on the femur"), not the shipped
+model: a forward simulation of it needs a timestep below about 0.05 ms (the patella's inertia
+on the coupling's stiffness), and it did not improve the knee contact.
+"""
+import math
+import os
+import re
+import sys
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from gs_scriptlib import PrepError, write_atomic  # noqa: E402
+
+PATFEM_REF = math.pi / 2   # patfem_flexion at knee_flexion 0 (JW's .osim coupler offset, rad)
+
+
+def vec(text):
+    return [float(v) for v in text.split()]
+
+
+def quat_mat(q):
+    w, x, y, z = q
+    n = math.sqrt(w * w + x * x + y * y + z * z)
+    w, x, y, z = w / n, x / n, y / n, z / n
+    return [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
+
+
+def mat_vec(r, v):
+    return [sum(r[i][k] * v[k] for k in range(3)) for i in range(3)]
+
+
+def mat_t_vec(r, v):
+    return [sum(r[k][i] * v[k] for k in range(3)) for i in range(3)]
+
+
+def quat_mul(a, b):
+    w1, x1, y1, z1 = a
+    w2, x2, y2, z2 = b
+    return [w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
+            w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2]
+
+
+def fmt(v):
+    return " ".join("%.10g" % a for a in v)
+
+
+def body_tag(text, name, path):
+    m = re.search(r'<body name="%s" pos="([^"]+)" quat="([^"]+)">' % name, text)
+    if not m:
+        raise PrepError(path, "no body %s with pos and quat" % name)
+    return m
+
+
+def variant(text, path):
+    """The variant's MJCF text from the model's."""
+    if "patfem_flexion" in text:
+        raise PrepError(path, "already has patfem_flexion")
+    tt = body_tag(text, "tibial_tray", path)
+    fj = re.search(r'<joint name="knee_flexion" type="hinge" axis="([^"]+)" pos="([^"]+)"', text)
+    if not fj:
+        raise PrepError(path, "no hinge knee_flexion with axis and pos")
+    pat = body_tag(text, "patella", path)
+    # cut the patella block out of tibial_tray
+    start = text.rfind("\n", 0, pat.start()) + 1
+    indent = text[start:pat.start()]
+    end = text.index("\n" + indent + "</body>", pat.start()) + len("\n" + indent + "</body>")
+    block = text[start:end]
+    text = text[:start] + text[end + 1:]
+    # poses in the femoral_component frame at the default pose (every knee coordinate at its
+    # ref: there tibial_tray sits at its pos / quat)
+    r_tt, p_tt = quat_mat(vec(tt.group(2))), vec(tt.group(1))
+    q_pat = quat_mul(vec(tt.group(2)), vec(pat.group(2)))
+    p_pat = [a + b for a, b in zip(p_tt, mat_vec(r_tt, vec(pat.group(1))))]
+    axis_fc = mat_vec(r_tt, vec(fj.group(1)))
+    anchor_fc = [a + b for a, b in zip(p_tt, mat_vec(r_tt, vec(fj.group(2))))]
+    r_pat = quat_mat(q_pat)
+    axis = mat_t_vec(r_pat, axis_fc)
+    anchor = mat_t_vec(r_pat, [a - b for a, b in zip(anchor_fc, p_pat)])
+    rng = re.search(r'<joint name="knee_flexion"[^>]*range="([^"]+)"', text)
+    lo, hi = vec(rng.group(1)) if rng else (-2.513, 0.349)
+    head = ('<body name="patella" pos="%s" quat="%s">\n%s  <joint name="patfem_flexion" '
+            'type="hinge" axis="%s" pos="%s" ref="%.10g" range="%.10g %.10g"/>') % (
+        fmt(p_pat), fmt(q_pat), indent, fmt(axis), fmt(anchor), PATFEM_REF,
+        lo + PATFEM_REF, hi + PATFEM_REF)
+    block = block.replace(pat.group(0), head)
+    block = "\n".join(line[2:] if line.startswith("  ") else line for line in block.split("\n"))
+    # the patella becomes femoral_component's last child
+    fc = body_tag(text, "femoral_component", path)
+    fc_indent = text[text.rfind("\n", 0, fc.start()) + 1:fc.start()]
+    close = text.index("\n" + fc_indent + "</body>", fc.start())
+    text = text[:close] + "\n" + block + text[close:]
+    # the coupling, then the keyframe's value at patfem_flexion's qpos address
+    eq = ('  <equality>\n    <joint name="patfem_coupler" joint1="patfem_flexion" '
+          'joint2="knee_flexion" polycoef="0 1 0 0 0"/>\n  </equality>\n')
+    if "<equality>" in text:
+        raise PrepError(path, "has an <equality> section already")
+    text = text.replace("  <tendon>", eq + "  <tendon>", 1)
+    body_start = text.index("<worldbody>")
+    address = len(re.findall(r"<joint name=", text[body_start:text.index('name="patfem_flexion"')]))
+    key = re.search(r'<key name="standing" qpos="([^"]+)"', text)
+    if key:
+        q = key.group(1).split()
+        q.insert(address, "%.10g" % PATFEM_REF)
+        text = text.replace(key.group(0), '<key name="standing" qpos="%s"' % " ".join(q))
+    return text.replace(
+        "<!--\n", "<!--\n  VARIANT by scripts/patella_variant.py: the right patella follows the "
+        "femoral component\n    (hinge patfem_flexion coupled to knee_flexion); not the shipped "
+        "model.\n", 1)
+
+
+def main(argv):
+    if len(argv) != 3:
+        print(__doc__.strip().split("\n\n")[1], file=sys.stderr)
+        return 2
+    try:
+        with open(argv[1]) as f:
+            text = f.read()
+        write_atomic(argv[2], variant(text, argv[1]))
+    except PrepError as e:
+        print("patella_variant.py: %s" % e, file=sys.stderr)
+        return 1
+    except OSError as e:
+        print("patella_variant.py: %s: %s" % (e.filename, e.strerror), file=sys.stderr)
+        return 1
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))

@@ -98,6 +98,16 @@ LM_MAX_TRIAL = 1.3
 LM_MIN_TRIAL = 0.4
 LM_MAX_HARD = 1.5
 MUSCLE_DENSITY = 1059.7   # kg/m^3 (Umberger et al. 2003)
+# Specific tension of the six lumped trunk muscles (ercspn, intobl, extobl; Pa), which sets their
+# metabolic mass Fmax / sigma * lopt * density. The 3dpredictsim table has no measurement for them
+# and carries OpenSim's default 0.25 MPa; with gait2392's trunk strengths (2500 N, 900 N) that
+# makes each erector spinae a 100 cm^2, 1.22 kg muscle, where MRI gives the living erector spinae
+# about 26 cm^2 a side (Marras et al. 2001, Clin Biomech 16:38) and cadavers 11.6 cm^2 (Delp et
+# al. 2001, J Biomech 34:371). Burkhart et al. 2018 (J Orthop Res 36:498) measured the apparent
+# maximum stress of the trunk extensors of 49 adults over 65 (JW was 80): 75.5 N/cm^2 on average
+# (40-130). That value for all six: erector spinae 0.40 kg a side, obliques 0.12 and 0.14 kg.
+TRUNK_SPECIFIC_TENSION = 0.755e6
+TRUNK_MUSCLES = ("ercspn_r", "ercspn_l", "intobl_r", "intobl_l", "extobl_r", "extobl_l")
 VMAX = 10.0               # lopt/s
 TAU_ACT = 0.010           # s
 TAU_DEACT = 0.040         # s
@@ -2473,6 +2483,8 @@ class Converter:
 
     def actuator_user(self, mus):
         st, sigma = self.metabolic[metabolic_key(mus["name"])]
+        if mus["name"] in TRUNK_MUSCLES:
+            sigma = TRUNK_SPECIFIC_TENSION
         mass = mus["fmax"] / sigma * mus["lopt"] * MUSCLE_DENSITY
         return [mus["fmax"], mus["lopt"], mus["lts"], mus["pennation"], VMAX, st, sigma, mass,
                 1.0 if mus["lts"] >= mus["lopt"] else 0.0, TAU_ACT, TAU_DEACT, TENDON_KT]
@@ -2491,7 +2503,8 @@ class Converter:
         out.append("  Source: %s from gilserrancoli/ReducePoly_forMSK (MIT licence)," % self.osim_name)
         out.append("    Knee Grand Challenge subject JW (right TKA, instrumented eTibia),")
         out.append("    Fregly et al. 2012, J Orthop Res 30:503. Metabolic muscle parameters:")
-        out.append("    antoinefalisse/3dpredictsim (MIT), Uchida et al. 2016.")
+        out.append("    antoinefalisse/3dpredictsim (MIT), Uchida et al. 2016; trunk muscles'")
+        out.append("    specific tension 0.755 MPa (Burkhart et al. 2018, J Orthop Res 36:498).")
         out.append("  %d DOF (hinge/slide only), %d muscles, total mass %s kg." % (
             len(MODEL_COORDINATES), len(m.muscles), fmt(total_mass, 6)))
         out.append("  Frames: body 'ground' rotates OpenSim's Y-up ground (X forward, Y up, Z right)")

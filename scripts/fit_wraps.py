@@ -100,11 +100,7 @@ def quat_rotvec(v):
     return [math.cos(a / 2), v[0] * s, v[1] * s, v[2] * s]
 
 
-def quat_to_mat(q):
-    w, x, y, z = q
-    return [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
+quat_to_mat = cv.mat_from_quat
 
 
 class Probe:

@@ -235,6 +235,14 @@ def tf_trans(p):
     return (IDENTITY, list(p))
 
 
+def mat_from_quat(q):
+    """Rotation matrix of a unit quaternion (w x y z)."""
+    w, x, y, z = q
+    return [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
+            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
+            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
+
+
 def quat_from_mat(r):
     """Unit quaternion (w x y z), w >= 0, of a rotation matrix."""
     tr = r[0][0] + r[1][1] + r[2][2]

@@ -29,6 +29,7 @@ import re
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import osim2mjcf as cv  # noqa: E402
 from gs_scriptlib import PrepError, write_atomic  # noqa: E402
 
 PATFEM_REF = math.pi / 2   # patfem_flexion at knee_flexion 0 (JW's .osim coupler offset, rad)
@@ -38,28 +39,10 @@ def vec(text):
     return [float(v) for v in text.split()]
 
 
-def quat_mat(q):
-    w, x, y, z = q
-    n = math.sqrt(w * w + x * x + y * y + z * z)
-    w, x, y, z = w / n, x / n, y / n, z / n
-    return [[1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)],
-            [2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)],
-            [2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)]]
-
-
-def mat_vec(r, v):
-    return [sum(r[i][k] * v[k] for k in range(3)) for i in range(3)]
-
-
-def mat_t_vec(r, v):
-    return [sum(r[k][i] * v[k] for k in range(3)) for i in range(3)]
-
-
-def quat_mul(a, b):
-    w1, x1, y1, z1 = a
-    w2, x2, y2, z2 = b
-    return [w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2, w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-            w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2, w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2]
+def unit_mat(q):
+    """Rotation matrix of a quaternion (w x y z), normalised first."""
+    n = math.sqrt(sum(a * a for a in q))
+    return cv.mat_from_quat([a / n for a in q])
 
 
 def fmt(v):
@@ -90,14 +73,14 @@ def variant(text, path):
     text = text[:start] + text[end + 1:]
     # poses in the femoral_component frame at the default pose (every knee coordinate at its
     # ref: there tibial_tray sits at its pos / quat)
-    r_tt, p_tt = quat_mat(vec(tt.group(2))), vec(tt.group(1))
-    q_pat = quat_mul(vec(tt.group(2)), vec(pat.group(2)))
-    p_pat = [a + b for a, b in zip(p_tt, mat_vec(r_tt, vec(pat.group(1))))]
-    axis_fc = mat_vec(r_tt, vec(fj.group(1)))
-    anchor_fc = [a + b for a, b in zip(p_tt, mat_vec(r_tt, vec(fj.group(2))))]
-    r_pat = quat_mat(q_pat)
-    axis = mat_t_vec(r_pat, axis_fc)
-    anchor = mat_t_vec(r_pat, [a - b for a, b in zip(anchor_fc, p_pat)])
+    r_tt, p_tt = unit_mat(vec(tt.group(2))), vec(tt.group(1))
+    r_pat = cv.mat_mul(r_tt, unit_mat(vec(pat.group(2))))
+    q_pat = cv.quat_from_mat(r_pat)
+    p_pat = cv.vec_add(p_tt, cv.mat_vec(r_tt, vec(pat.group(1))))
+    axis_fc = cv.mat_vec(r_tt, vec(fj.group(1)))
+    anchor_fc = cv.vec_add(p_tt, cv.mat_vec(r_tt, vec(fj.group(2))))
+    axis = cv.mat_vec(cv.mat_t(r_pat), axis_fc)
+    anchor = cv.mat_vec(cv.mat_t(r_pat), cv.vec_sub(anchor_fc, p_pat))
     rng = re.search(r'<joint name="knee_flexion"[^>]*range="([^"]+)"', text)
     lo, hi = vec(rng.group(1)) if rng else (-2.513, 0.349)
     head = ('<body name="patella" pos="%s" quat="%s">\n%s  <joint name="patfem_flexion" '

@@ -44,11 +44,8 @@ double gs_coupling_target(const mjModel* m, int c, double qd, double* slope);
 // and qvel only).
 void gs_coupling_passive(const mjModel* m, mjData* d);
 
-// 1 when dof j is the follower of an adopted coupling (held by the coupling, not by muscles).
-int gs_coupling_is_follower(const mjModel* m, int j);
-
 // 1 when joint jnt is the follower of a joint equality, adopted or still MuJoCo's (active): a
-// coordinate a pose file may leave out.
+// coordinate a pose file may leave out, held by the coupling rather than by muscles.
 int gs_coupling_joint_follows(const mjModel* m, int jnt);
 
 // Put every coupled follower whose value is not given on its target: qpos (nq) from the driver's

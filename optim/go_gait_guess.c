@@ -54,24 +54,22 @@ int go_gait_guess_from_trial(const go_gait* g, const gsTable* coords, double act
     return -1;
   }
   memcpy(fine.time, coords->time, sizeof(double) * (size_t)R);
-  for (int j = 0; j < nv; j++) {
-    int c = gs_table_column(coords, mj_id2name(m, mjOBJ_JOINT, m->dof_jntid[j]));
-    for (int r = 0; r < R; r++) {
-      fine.data[r * fine.ncol + j] = c >= 0 ? coords->data[r * coords->ncol + c] : m->qpos0[j];
-    }
-  }
-  // coupled coordinates the trial lacks (the patella) follow their driver (gs_coupling.h); nq ==
-  // nv here (hinge and slide joints only)
-  int* given = (int*)malloc(sizeof(int) * (size_t)nv);
-  if (!given) {
+  // the trial's column of each coordinate (nq == nv here: hinge and slide joints only)
+  int* col = (int*)malloc(sizeof(int) * (size_t)nv);
+  if (!col) {
     gs_table_free(&fine);
     snprintf(err, errsz, "go_gait_guess: out of memory");
     return -1;
   }
-  for (int j = 0; j < nv; j++)
-    given[j] = gs_table_column(coords, mj_id2name(m, mjOBJ_JOINT, m->dof_jntid[j]));
-  for (int r = 0; r < R; r++) gs_coupling_follow(m, fine.data + r * fine.ncol, NULL, given, NULL);
-  free(given);
+  for (int j = 0; j < nv; j++) {
+    int c = col[j] = gs_table_column(coords, mj_id2name(m, mjOBJ_JOINT, m->dof_jntid[j]));
+    for (int r = 0; r < R; r++) {
+      fine.data[r * fine.ncol + j] = c >= 0 ? coords->data[r * coords->ncol + c] : m->qpos0[j];
+    }
+  }
+  // coupled coordinates the trial lacks (the patella) follow their driver (gs_coupling.h)
+  for (int r = 0; r < R; r++) gs_coupling_follow(m, fine.data + r * fine.ncol, NULL, col, NULL);
+  free(col);
   for (int j = 0; j < nv; j++) {
     periodic_diff(fine.time, fine.data + j, R, fine.ncol, fine.data + nv + j);
     periodic_diff(fine.time, fine.data + nv + j, R, fine.ncol, fine.data + 2 * nv + j);
@@ -319,7 +317,7 @@ static int held_by_knee_model(const mjModel* m, int j) {
 
 int go_static_dof_matched(const mjModel* m, int j) {
   return !go_gait_dof_is_root(m, j) && !(m->jnt_stiffness[m->dof_jntid[j]] > 0) &&
-         !held_by_knee_model(m, j) && !gs_coupling_is_follower(m, j);
+         !held_by_knee_model(m, j) && !gs_coupling_joint_follows(m, m->dof_jntid[j]);
 }
 
 // Cholesky factorisation of the SPD matrix A (n x n, row-major, lower triangle overwritten) and

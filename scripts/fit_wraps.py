@@ -100,9 +100,6 @@ def quat_rotvec(v):
     return [math.cos(a / 2), v[0] * s, v[1] * s, v[2] * s]
 
 
-quat_to_mat = cv.mat_from_quat
-
-
 class Probe:
     """build/path_probe on one model file: MuJoCo's lengths and moment arms."""
 
@@ -294,7 +291,7 @@ def feasible(parts):
             # first fit, at a 1.2 m/s prediction's iterate), and at the surface the choice
             # between the two hangs on a rounding
             rel = [q["side"][i] - q["pos"][i] for i in range(3)]
-            m = quat_to_mat(q["quat"])
+            m = cv.mat_from_quat(q["quat"])
             local = [sum(m[i][k] * rel[i] for i in range(3)) for k in range(3)]
             dist = math.hypot(local[0], local[1]) if q["type"] == "cylinder" else \
                 math.sqrt(sum(v * v for v in local))

@@ -2512,7 +2512,8 @@ class Converter:
         out.append("    Knee Grand Challenge subject JW (right TKA, instrumented eTibia),")
         out.append("    Fregly et al. 2012, J Orthop Res 30:503. Metabolic muscle parameters:")
         out.append("    antoinefalisse/3dpredictsim (MIT), Uchida et al. 2016; trunk muscles'")
-        out.append("    specific tension 0.755 MPa (Burkhart et al. 2018, J Orthop Res 36:498).")
+        out.append("    specific tension %s MPa (Burkhart et al. 2018, J Orthop Res 36:498)." % fmt(
+            TRUNK_SPECIFIC_TENSION / 1e6))
         out.append("  %d DOF (hinge/slide only), %d muscles, total mass %s kg." % (
             len(MODEL_COORDINATES), len(m.muscles), fmt(total_mass, 6)))
         out.append("  Frames: body 'ground' rotates OpenSim's Y-up ground (X forward, Y up, Z right)")

@@ -45,10 +45,6 @@ def unit_mat(q):
     return cv.mat_from_quat([a / n for a in q])
 
 
-def fmt(v):
-    return " ".join("%.10g" % a for a in v)
-
-
 def body_tag(text, name, path):
     m = re.search(r'<body name="%s" pos="([^"]+)" quat="([^"]+)">' % name, text)
     if not m:
@@ -85,8 +81,8 @@ def variant(text, path):
     lo, hi = vec(rng.group(1)) if rng else (-2.513, 0.349)
     head = ('<body name="patella" pos="%s" quat="%s">\n%s  <joint name="patfem_flexion" '
             'type="hinge" axis="%s" pos="%s" ref="%.10g" range="%.10g %.10g"/>') % (
-        fmt(p_pat), fmt(q_pat), indent, fmt(axis), fmt(anchor), PATFEM_REF,
-        lo + PATFEM_REF, hi + PATFEM_REF)
+        cv.fvec(p_pat, 10), cv.fvec(q_pat, 10), indent, cv.fvec(axis, 10), cv.fvec(anchor, 10),
+        PATFEM_REF, lo + PATFEM_REF, hi + PATFEM_REF)
     block = block.replace(pat.group(0), head)
     block = "\n".join(line[2:] if line.startswith("  ") else line for line in block.split("\n"))
     # the patella becomes femoral_component's last child

@@ -117,19 +117,31 @@ double gs_muscle_fv_inverse(double fV, double* deriv) {
   return (sinh(x) - GS_MUSCLE_D3) / GS_MUSCLE_D2;
 }
 
+// smooth max(p, 0) = (p + sqrt(p^2 + w^2)) / 2 and its derivative d/dp (w GS_MUSCLE_PASSIVE_WIDTH)
+static double passive_floor(double p, double* dp) {
+  const double w = GS_MUSCLE_PASSIVE_WIDTH;
+  double r = sqrt(p * p + w * w);
+  if (dp) {
+    *dp = 0.5 * (1.0 + p / r);
+  }
+  return 0.5 * (p + r);
+}
+
 double gs_muscle_fl_passive(double lM_norm, double* deriv) {
   const double k = GS_MUSCLE_KPE / GS_MUSCLE_E0;
   const double den = exp(GS_MUSCLE_KPE) - 1.0;
   double x = k * (lM_norm - 1.0);
-  double e = exp_clamped(x);
+  double e = exp_clamped(x), dfloor;
+  double f = passive_floor((e - 1.0) / den, &dfloor);
   if (deriv) {
-    *deriv = x < GS_MUSCLE_EXP_MAX ? k * e / den : 0.0;
+    *deriv = x < GS_MUSCLE_EXP_MAX ? dfloor * k * e / den : 0.0;
   }
-  return (e - 1.0) / den;
+  return f;
 }
 
 double gs_muscle_fl_passive_min(void) {
-  return -(1.0 - exp(-GS_MUSCLE_KPE / GS_MUSCLE_E0)) / (exp(GS_MUSCLE_KPE) - 1.0);
+  return passive_floor(-(1.0 - exp(-GS_MUSCLE_KPE / GS_MUSCLE_E0)) / (exp(GS_MUSCLE_KPE) - 1.0),
+                       NULL);
 }
 
 double gs_muscle_ft(double lT_norm, double kT, double* deriv) {

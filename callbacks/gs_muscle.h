@@ -54,7 +54,8 @@
 #define GS_MUSCLE_D2 -8.149
 #define GS_MUSCLE_D3 -0.374
 #define GS_MUSCLE_D4 0.8825327733249912
-// passive force-length, fPE = (exp(kPE (l - 1) / e0) - 1) / (exp(kPE) - 1) (-)
+// passive force-length, fPE = (exp(kPE (l - 1) / e0) - 1) / (exp(kPE) - 1) (-), joined to zero
+// below optimal length by a smooth max of width GS_MUSCLE_PASSIVE_WIDTH (see gs_muscle_fl_passive)
 #define GS_MUSCLE_KPE 4.0
 #define GS_MUSCLE_E0 0.6
 // tendon force-length, fT = c1 exp(kT (l - c2)) - c3 (-); kT per muscle (user row), 35 default.
@@ -71,6 +72,9 @@
 #define GS_MUSCLE_DAMPING_DEFAULT 0.01
 // thickness floor as a fraction of lopt (-): see "Guard" above
 #define GS_MUSCLE_MIN_THICKNESS 1e-3
+// width of the smooth max that takes the passive curve to zero below optimal length (normalised
+// force, -): fPE(1) = width / 2 = 5e-4, fPE = 1.3e-5 at short lengths, 2.5e-7 off at l = 1.6
+#define GS_MUSCLE_PASSIVE_WIDTH 1e-3
 // smallest fT_norm + c3 accepted by the tendon inverse (-): fT_norm must exceed -c3 = -0.25
 #define GS_MUSCLE_MIN_FT_SHIFT 1e-9
 // |vM_norm| limit of the forward solve (-); beyond it the result is clamped and flagged
@@ -147,15 +151,24 @@ double gs_muscle_fv(double vM_norm, double* deriv);
 // +-30 (|vM_norm| ~ 1e12, never physiological). deriv: dvM_norm/dfV (-).
 double gs_muscle_fv_inverse(double fV, double* deriv);
 
-// Passive force-length multiplier fPE(lM_norm) (-), eq. for f_PE:
-//   fPE = (exp(kPE (l - 1) / e0) - 1) / (exp(kPE) - 1),  kPE = 4, e0 = 0.6;
-// fPE(1) = 0, fPE(1.6) = 1. Not clamped: below l = 1 it is slightly NEGATIVE, decreasing to
-// -(1 - exp(-kPE/e0)) / (exp(kPE) - 1) = -0.01863 as l -> 0 (a small compressive force, as
-// published; kept so the curve stays the paper's and C-infinity). The exponent is clamped at 700
+// Passive force-length multiplier fPE(lM_norm) (-), the parallel elastic element:
+//   p = (exp(kPE (l - 1) / e0) - 1) / (exp(kPE) - 1),  kPE = 4, e0 = 0.6 (De Groote 2016),
+//   fPE = (p + sqrt(p^2 + w^2)) / 2,  w = GS_MUSCLE_PASSIVE_WIDTH = 1e-3.
+// De Groote's p passes through zero at l = 1 and is NEGATIVE below, down to -0.0186 Fmax: a
+// fibre that pushes. With the tendon force bounded at zero (a slack tendon cannot push either),
+// an unopposed push must be cancelled by activation: a slack muscle whose fibre sits at 0.6 lopt
+// needs a = 0.06 to stay in equilibrium, which Umberger's heat prices at a cost per second. The
+// parallel elastic element is slack below optimal length in OpenSim's Thelen2003Muscle (zero
+// below lopt) and Millard2012EquilibriumMuscle (its fibre force-length curve starts at strain 0);
+// OpenSim Moco's DeGrooteFregly2016Muscle shifts De Groote's curve so that it does not go negative
+// for the same reason. gaitsim keeps De Groote's curve above optimal length and takes the smooth
+// max with zero: fPE(1) = w / 2, fPE >= 1.34e-5 (gs_muscle_fl_passive_min) as l -> 0, within
+// w^2 / (4 p) of p above (2.5e-7 at l = 1.6), C-infinity. The exponent is clamped at 700
 // (l > 106) against overflow. deriv: dfPE/dlM_norm (-).
 double gs_muscle_fl_passive(double lM_norm, double* deriv);
 
-// Lower bound of fPE over lM_norm >= 0 (-): -(1 - exp(-kPE/e0)) / (exp(kPE) - 1).
+// Lower bound of fPE over lM_norm >= 0 (-), its value as lM_norm -> 0 (p = -(1 - exp(-kPE/e0)) /
+// (exp(kPE) - 1) = -0.01863 there): (p + sqrt(p^2 + w^2)) / 2 = 1.34e-5.
 double gs_muscle_fl_passive_min(void);
 
 // Tendon force-length fT(lT_norm) (-), eq. for f_T: fT = c1 exp(kT (l - c2)) - c3, kT (-) per

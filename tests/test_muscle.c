@@ -345,17 +345,22 @@ static void curves_should_have_their_published_properties(void) {
     EXPECT_NEAR(v, gs_muscle_fv_inverse(f, NULL), 1e-12);
   }
 
-  // fPE: 0 at 1, 1 at 1 + e0, >= 0 above 1, negative but >= fPE_min = -0.01863 below; increasing
-  EXPECT_NEAR(0.0, gs_muscle_fl_passive(1.0, NULL), 1e-16);
-  EXPECT_NEAR(1.0, gs_muscle_fl_passive(1.0 + GS_MUSCLE_E0, NULL), 1e-14);
-  EXPECT_NEAR(-0.0186336, gs_muscle_fl_passive_min(), 1e-7);
+  // fPE: De Groote's p = (exp(kPE (l - 1) / e0) - 1) / (exp(kPE) - 1) above optimal length,
+  // zero below, joined by the smooth max (p + sqrt(p^2 + w^2)) / 2: w / 2 = 5e-4 at 1, 1 at
+  // 1 + e0 within w^2 / 4, never negative (the published p goes down to -0.01863), within 3e-5
+  // of zero below 0.9 lopt, within w^2 / (4 p) of p above 1.1; increasing
+  EXPECT_NEAR(0.5 * GS_MUSCLE_PASSIVE_WIDTH, gs_muscle_fl_passive(1.0, NULL), 1e-16);
+  EXPECT_NEAR(1.0, gs_muscle_fl_passive(1.0 + GS_MUSCLE_E0, NULL), 3e-7);
+  EXPECT_NEAR(1.3407e-5, gs_muscle_fl_passive_min(), 1e-9);
   for (int i = 0; i <= 2000; i++) {
     double l = 1.8 * i / 2000.0, f = gs_muscle_fl_passive(l, &d);
+    double p = (exp(4.0 * (l - 1.0) / 0.6) - 1.0) / (exp(4.0) - 1.0);
     EXPECT_TRUE(d > 0.0);
-    if (l >= 1.0) {
-      EXPECT_TRUE(f >= 0.0);
-    } else {
-      EXPECT_TRUE(f < 0.0 && f >= gs_muscle_fl_passive_min());
+    EXPECT_TRUE(f > 0.0 && f >= gs_muscle_fl_passive_min());
+    if (l <= 0.9) {
+      EXPECT_TRUE(f < 3e-5);
+    } else if (l >= 1.1) {
+      EXPECT_NEAR(p, f, 1e-6 / (4.0 * p));
     }
   }
 

@@ -1560,6 +1560,16 @@ static int metabolic_mask(go_gait* g) {
   return 0;
 }
 
+// eq. 3's band [centre - half, centre + half] of variable var at node k intersected with the
+// variable's bounds z_lb, z_ub (setup_bounds: the joint ranges); the bounds alone where the two
+// do not overlap (a centre more than half outside its range)
+static go_bound_override band_within_bounds(const go_gait* g, int k, int var, double centre,
+                                           double half) {
+  double lo = fmax(centre - half, g->z_lb[var]), hi = fmin(centre + half, g->z_ub[var]);
+  if (lo > hi) lo = g->z_lb[var], hi = g->z_ub[var];
+  return (go_bound_override){k, var, lo, hi};
+}
+
 // the NLP (go_collocation.h) with eq. 3's band as bound overrides, and the Hessian elements
 static int setup_nlp(go_gait* g, const go_gait_opts* o, char* err, int errsz) {
   const go_gait_layout* L = &g->L;
@@ -1573,7 +1583,9 @@ static int setup_nlp(go_gait* g, const go_gait_opts* o, char* err, int errsz) {
   p.T_lb = o->T_lb;
   p.T_ub = o->T_ub;
   p.T_scale = g->T;
-  // eq. 3 of Lin, Walter & Pandy 2018: q and qdot within a band around a given solution
+  // eq. 3 of Lin, Walter & Pandy 2018: q and qdot within a band around a given solution, and
+  // within the variable's own bounds (the joint ranges of setup_bounds): each override is the
+  // band intersected with them, or the bounds alone where the band lies outside them
   if (o->band_z) {
     g->band = (go_bound_override*)zalloc((size_t)4 * g->N * nv, sizeof(go_bound_override));
     if (!g->band) return out_of_memory(err, errsz, "band");
@@ -1581,12 +1593,10 @@ static int setup_nlp(go_gait* g, const go_gait_opts* o, char* err, int errsz) {
       const double* zk = o->band_z + (size_t)k * nz;
       for (int j = 0; j < nv; j++) {
         if (o->band_q && o->band_q[j] > 0 && j != L->tx)
-          g->band[g->n_band++] = (go_bound_override){k, L->x_q + j, zk[L->x_q + j] - o->band_q[j],
-                                                      zk[L->x_q + j] + o->band_q[j]};
+          g->band[g->n_band++] = band_within_bounds(g, k, L->x_q + j, zk[L->x_q + j], o->band_q[j]);
         if (o->band_qd && o->band_qd[j] > 0)
-          g->band[g->n_band++] = (go_bound_override){k, L->x_qd + j,
-                                                      zk[L->x_qd + j] - o->band_qd[j],
-                                                      zk[L->x_qd + j] + o->band_qd[j]};
+          g->band[g->n_band++] =
+              band_within_bounds(g, k, L->x_qd + j, zk[L->x_qd + j], o->band_qd[j]);
       }
     }
     p.overrides = g->band;

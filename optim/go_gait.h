@@ -130,7 +130,9 @@ typedef struct {
   int free_time;                    // 1: stride time T is a variable in [T_lb, T_ub]
   double T_lb, T_ub;                // bounds of T (s); equal: T held fixed (Ipopt fixes it)
   const double* band_z;             // NULL, or node variables (N nz, physical) of the solution
-                                    // the band of eq. 3 is centred on (the tracking solution)
+                                    // the band of eq. 3 is centred on (the tracking solution);
+                                    // the band is intersected with the joint ranges (the range
+                                    // alone where a centre lies more than the half-width out)
   const double* band_q;             // half-width per dof of the coordinate band (nv; <= 0: none)
   const double* band_qd;            // half-width per dof of the speed band (nv; <= 0: none)
   int fibre_bounds;                 // 1: fibre path rows fibre_lo <= lM/lopt <= fibre_hi (eq. 2)

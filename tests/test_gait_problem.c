@@ -508,6 +508,71 @@ int main(void) {
     EXPECT_TRUE(memcmp(&f, &f2, sizeof(double)) == 0);
   }
 
+  // eq. 3's band within the joint ranges: a 0.05 rad band around the guess, intersected with each
+  // limited joint's range; a centre moved 1 rad past its joint's upper limit gets the range alone
+  {
+    const mjModel* gm = go_gait_model(g1);
+    int jq = -1;  // the first limited dof whose guess lies inside its range
+    for (int j = 0; j < L->nv && jq < 0; j++) {
+      int jnt = gm->dof_jntid[j];
+      double v = z[L->x_q + j];
+      if (gm->jnt_limited[jnt] && v > gm->jnt_range[2 * jnt] && v < gm->jnt_range[2 * jnt + 1])
+        jq = j;
+    }
+    EXPECT_TRUE(jq >= 0);
+    double* zc = malloc(sizeof(double) * (size_t)n);
+    double* half = malloc(sizeof(double) * (size_t)L->nv);
+    double* zl = malloc(sizeof(double) * (size_t)n);
+    double* zu = malloc(sizeof(double) * (size_t)n);
+    double* zlp = malloc(sizeof(double) * (size_t)n);
+    double* zup = malloc(sizeof(double) * (size_t)n);
+    memcpy(zc, z, sizeof(double) * (size_t)n);
+    int jnt_q = jq >= 0 ? gm->dof_jntid[jq] : 0;
+    if (jq >= 0) zc[(size_t)2 * L->nz + L->x_q + jq] = gm->jnt_range[2 * jnt_q + 1] + 1.0;
+    for (int j = 0; j < L->nv; j++) half[j] = 0.05;
+    go_gait_opts o = gs_test_tracking_opts(&coords, &grf, 4);  // g1's layout (make, extras)
+    o.w_accel = W_ACCEL;
+    o.w_grm = W_GRM;
+    o.fibre_bounds = 1;
+    o.min_vgrf = MIN_VGRF;
+    o.speed = 1.27;
+    o.band_z = zc;
+    o.band_q = half;
+    go_gait* gb = NULL;
+    EXPECT_EQ_INT(0, go_gait_create(&gb, m, &o, err, sizeof(err)));
+    if (gb && jq >= 0) {
+      go_nlp_bounds(go_gait_nlp(gb), zl, zu, NULL, NULL);
+      go_nlp_unscale_z(go_gait_nlp(gb), zl, zlp);
+      go_nlp_unscale_z(go_gait_nlp(gb), zu, zup);
+      int outside = 0, wrong = 0;
+      for (int k = 0; k < 4; k++)
+        for (int j = 0; j < L->nv; j++) {
+          if (j == L->tx) continue;
+          size_t v = (size_t)k * L->nz + L->x_q + j;
+          int jnt = gm->dof_jntid[j];
+          double lo = zc[v] - 0.05, hi = zc[v] + 0.05;
+          if (gm->jnt_limited[jnt]) {
+            outside += zlp[v] < gm->jnt_range[2 * jnt] - 1e-12 ||
+                       zup[v] > gm->jnt_range[2 * jnt + 1] + 1e-12;
+            lo = fmax(lo, gm->jnt_range[2 * jnt]);
+            hi = fmin(hi, gm->jnt_range[2 * jnt + 1]);
+            if (lo > hi) lo = gm->jnt_range[2 * jnt], hi = gm->jnt_range[2 * jnt + 1];
+          }
+          wrong += fabs(zlp[v] - lo) > 1e-9 * fmax(1, fabs(lo)) ||
+                   fabs(zup[v] - hi) > 1e-9 * fmax(1, fabs(hi));
+        }
+      EXPECT_EQ_INT(0, outside);
+      EXPECT_EQ_INT(0, wrong);
+      size_t v2 = (size_t)2 * L->nz + L->x_q + jq;  // the moved centre: the whole range
+      EXPECT_NEAR(gm->jnt_range[2 * jnt_q], zlp[v2], 1e-9);
+      EXPECT_NEAR(gm->jnt_range[2 * jnt_q + 1], zup[v2], 1e-9);
+      printf("band within ranges: dof %d at node 2 gets its range [%g, %g] rad\n", jq, zlp[v2],
+             zup[v2]);
+    }
+    go_gait_free(gb);
+    free(zc), free(half), free(zl), free(zu), free(zlp), free(zup);
+  }
+
   // the partitioned quasi-Newton Hessian accepts the elements (fibre rows: rigid muscles in the
   // dynamics element, elastic ones in their tendon element, every fibre row in exactly one)
   {

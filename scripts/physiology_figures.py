@@ -13,7 +13,8 @@ RESULTS (default results) is the folder `gaitsim run` writes. Prints:
     and the mean lumbar_extension (deg), and what its muscles spend while slack: the stride-mean
     power of every muscle at the node intervals where its tendon force (muscle_forces.sto) is
     below 1 % of its Fmax, above Umberger's 1 W/kg floor (Fmax and mass from the `user` rows of
-    the model summary.json names; W, and W/kg of body mass), the five largest by name;
+    the model summary.json names; W, and W/kg of body mass), the five largest by name, and the
+    coordinates that leave the model's joint ranges (deg, or m for slides);
   - over three predictions or more, each group's power in Ralston's form a + b v^2 (least
     squares; W/kg, v in m/s): a, the cost per second whatever the speed, which makes the cost of
     transport fall with speed, and b; beside Ralston 1958's muscle share (his gross rate less the
@@ -29,6 +30,7 @@ femoris, hamstrings, gluteals, iliopsoas, adductors, tibialis anterior, other. E
 line naming the file when an input is missing.
 """
 import glob
+import math
 import os
 import re
 import sys
@@ -109,7 +111,49 @@ def prediction(folder):
     if not s.get("model"):
         raise PrepError(os.path.join(folder, "summary.json"), "no model")
     slack_cost(s["model"], met, columns(os.path.join(folder, "muscle_forces.sto")), mass)
+    outside = outside_ranges(s["model"], columns(os.path.join(folder, "states.sto")))
+    print("  joint ranges (model): " + ("; ".join(outside) if outside else "all kept"))
     return speed, power, total
+
+
+def joint_ranges(model):
+    """{joint: (lo, hi)} of the model's limited hinge (deg) and slide (m) joints, from each
+    <joint>'s own range (angles in radians when <compiler angle="radian">, else degrees, as MuJoCo
+    reads them; limited="false" skipped; ranges set through default classes are not read)."""
+    try:
+        root = ET.parse(model).getroot()
+    except OSError as e:
+        raise PrepError(model, f"cannot read the model ({e.strerror})")
+    except ET.ParseError as e:
+        raise PrepError(model, f"not an MJCF file ({e})")
+    radian = any(c.get("angle") == "radian" for c in root.iter("compiler"))
+    out = {}
+    for j in root.iter("joint"):
+        if not j.get("name") or not j.get("range") or j.get("limited") == "false":
+            continue
+        try:
+            lo, hi = (float(x) for x in j.get("range").split())
+        except ValueError:
+            raise PrepError(model, f"joint {j.get('name')}: range is not two numbers")
+        if j.get("type", "hinge") == "hinge" and radian:
+            lo, hi = math.degrees(lo), math.degrees(hi)
+        out[j.get("name")] = (lo, hi)
+    return out
+
+
+def outside_ranges(model, states):
+    """The coordinates of states (states.sto columns: deg for hinges, m for slides) that leave
+    the model's joint ranges, each as 'name extreme below|above bound'."""
+    out = []
+    for name, (lo, hi) in joint_ranges(model).items():
+        values = states.get(name)
+        if not values:
+            continue
+        if min(values) < lo - 1e-9:
+            out.append(f"{name} {min(values):.2f} below {lo:.2f}")
+        if max(values) > hi + 1e-9:
+            out.append(f"{name} {max(values):.2f} above {hi:.2f}")
+    return out
 
 
 def speed_fit(rows):

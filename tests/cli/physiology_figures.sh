@@ -13,7 +13,9 @@
 # the fit a + b v^2 gives the trunk a = 2.943, b = 0 W/kg (a / v 2.943 .. 1.471 J/(kg m)), the
 # vasti a = 0, b = 0.245, the muscles a = 2.943, b = 0.245, beside Ralston's 0.822 + 1.331 v^2
 # less the basal 1.2 W/kg; a missing states.sto, a missing model or a model whose user row is
-# not numbers exits 1 with one line naming the file.
+# not numbers exits 1 with one line naming the file. The prediction's lumbar_extension (-15 and
+# -17 deg) leaves the model's range of -15 ... +28.6 deg (radians in the file), not -20 ... +30
+# (degrees, the default when <compiler> gives no angle).
 # usage: physiology_figures.sh GAITSIM SOURCE_DIR
 set -u
 src=$2
@@ -37,7 +39,9 @@ sto("results/sweep/predict_2/states.sto", ["time", "lumbar_extension"], [[0, -15
 sto("results/sweep/predict_2/muscle_forces.sto", ["time", "ercspn_r", "vasint"],
     [[0.25 * k, 500.0, 5.0] for k in range(5)])
 with open("m.xml", "w") as f:
-    f.write('<mujoco><actuator>'
+    f.write('<mujoco><compiler angle="radian"/><worldbody><body>'
+            '<joint name="lumbar_extension" range="-0.2617993877991494 0.5"/>'
+            '<joint name="pelvis_ty" type="slide" range="0 1"/></body></worldbody><actuator>'
             '<muscle name="ercspn_r" user="2500 0.115 0.03 0 10 0.6 250000 1.22 0 0.01 0.04 35"/>'
             '<muscle name="vasint" user="1000 0.099 0.24 0.08 10 0.5 552630 0.2 1 0.01 0.04 35"/>'
             '</actuator></mujoco>')
@@ -55,6 +59,8 @@ check "trunk 75 %" grep -qE "^  trunk +2\.943 W/kg +1\.472 J/\(kg m\) +75\.0 %$"
 check "vasti 25 %" grep -qE "^  vasti +0\.981 W/kg +0\.490 J/\(kg m\) +25\.0 %$" <<<"$out"
 check "slack: vasint 99.8 W above its 0.2 W floor" grep -qF \
   "  slack muscles (tendon force < 1 % Fmax), above the 1 W/kg floor: 99.8 W (0.979 W/kg); vasint 99.8, ercspn_r 0.0" <<<"$out"
+check "joint ranges: lumbar_extension -17 below -15 deg" grep -qxF \
+  "  joint ranges (model): lumbar_extension -17.00 below -15.00" <<<"$out"
 check "one prediction: no fit" test "$(grep -c "Ralston's form" <<<"$out")" -eq 0
 
 /usr/bin/python3 - <<'PY'
@@ -97,6 +103,11 @@ check "--gaitsim: bending 4.0 / 4.0" grep -qE "^  lumbar_bending +4\.0 +4\.0$" <
 check "--gaitsim: rotation 0" grep -qE "^  lumbar_rotation +0\.0 +0\.0$" <<<"$out"
 
 cp m.xml m.good
+sed -i 's/<compiler angle="radian"\/>//; s/range="-0.2617993877991494 0.5"/range="-20 30"/' m.xml
+out=$(/usr/bin/python3 "$src/scripts/physiology_figures.py" results)
+check "joint ranges in degrees (no compiler angle): all kept" grep -qxF \
+  "  joint ranges (model): all kept" <<<"$out"
+cp m.good m.xml
 printf '<mujoco><actuator><muscle name="vasint" user="1000 x"/></actuator></mujoco>' >m.xml
 err=$(/usr/bin/python3 "$src/scripts/physiology_figures.py" results 2>&1 >/dev/null)
 status=$?

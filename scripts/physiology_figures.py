@@ -116,16 +116,21 @@ def prediction(folder):
     return speed, power, total
 
 
-def joint_ranges(model):
-    """{joint: (lo, hi)} of the model's limited hinge (deg) and slide (m) joints, from each
-    <joint>'s own range (angles in radians when <compiler angle="radian">, else degrees, as MuJoCo
-    reads them; limited="false" skipped; ranges set through default classes are not read)."""
+def model_root(model):
+    """The MJCF file's root element; PrepError naming the file when it cannot be read."""
     try:
-        root = ET.parse(model).getroot()
+        return ET.parse(model).getroot()
     except OSError as e:
         raise PrepError(model, f"cannot read the model ({e.strerror})")
     except ET.ParseError as e:
         raise PrepError(model, f"not an MJCF file ({e})")
+
+
+def joint_ranges(model):
+    """{joint: (lo, hi)} of the model's limited hinge (deg) and slide (m) joints, from each
+    <joint>'s own range (angles in radians when <compiler angle="radian">, else degrees, as MuJoCo
+    reads them; limited="false" skipped; ranges set through default classes are not read)."""
+    root = model_root(model)
     radian = any(c.get("angle") == "radian" for c in root.iter("compiler"))
     out = {}
     for j in root.iter("joint"):
@@ -177,12 +182,7 @@ FLOOR_W_PER_KG = 1.0    # Umberger's minimum heat rate per kg of muscle (gs_meta
 
 def muscle_params(model):
     """{muscle: (Fmax N, mass kg)} from the MJCF `user` rows (gs_model_layout.h: 0 and 7)."""
-    try:
-        root = ET.parse(model).getroot()
-    except OSError as e:
-        raise PrepError(model, f"cannot read the model ({e.strerror})")
-    except ET.ParseError as e:
-        raise PrepError(model, f"not an MJCF file ({e})")
+    root = model_root(model)
     out = {}
     for m in root.iter("muscle"):
         try:

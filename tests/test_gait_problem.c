@@ -36,8 +36,7 @@ static double now(void) {
 
 // extras: the acceleration goal, the fibre-length rows and the walk row (floor MIN_VGRF BW)
 #define MIN_VGRF 0.1
-static go_gait* make(const mjModel* m, const gsTable* coords, const gsTable* grf, int nthreads,
-                     int extras) {
+static go_gait_opts opts_of(const gsTable* coords, const gsTable* grf, int nthreads, int extras) {
   go_gait_opts o = gs_test_tracking_opts(coords, grf, 4);
   o.w_accel = extras ? W_ACCEL : 0;
   o.w_grm = extras ? W_GRM : 0;
@@ -45,6 +44,12 @@ static go_gait* make(const mjModel* m, const gsTable* coords, const gsTable* grf
   o.min_vgrf = extras ? MIN_VGRF : 0;
   o.nthreads = nthreads;
   o.speed = 1.27;
+  return o;
+}
+
+static go_gait* make(const mjModel* m, const gsTable* coords, const gsTable* grf, int nthreads,
+                     int extras) {
+  go_gait_opts o = opts_of(coords, grf, nthreads, extras);
   return gs_test_gait_create(m, &o);
 }
 
@@ -530,12 +535,7 @@ int main(void) {
     int jnt_q = jq >= 0 ? gm->dof_jntid[jq] : 0;
     if (jq >= 0) zc[(size_t)2 * L->nz + L->x_q + jq] = gm->jnt_range[2 * jnt_q + 1] + 1.0;
     for (int j = 0; j < L->nv; j++) half[j] = 0.05;
-    go_gait_opts o = gs_test_tracking_opts(&coords, &grf, 4);  // g1's layout (make, extras)
-    o.w_accel = W_ACCEL;
-    o.w_grm = W_GRM;
-    o.fibre_bounds = 1;
-    o.min_vgrf = MIN_VGRF;
-    o.speed = 1.27;
+    go_gait_opts o = opts_of(&coords, &grf, 1, 1);  // g1's problem (and layout), with the band
     o.band_z = zc;
     o.band_q = half;
     go_gait* gb = NULL;

@@ -90,6 +90,7 @@ static double finish(const umbConst* c, double scale_a, double am, double sl, do
     terms->work = work;
     terms->rate = rate;
     terms->power = rate * c->mass;
+    terms->work_power = work * c->mass;
   }
   return rate * c->mass;
 }

@@ -63,6 +63,7 @@ typedef struct gsUmbergerTerms_ {
   double work;          // positive contractile mechanical work rate W    (W/kg)
   double rate;          // heat + work                                    (W/kg)
   double power;         // rate * m, the muscle's metabolic power Edot    (W)
+  double work_power;    // work * m, the positive contractile work rate    (W)
 } gsUmbergerTerms;
 
 // Widths of the smooth variant; gs_umberger_smoothing_default() gives the values below.

@@ -103,7 +103,13 @@ static void exact_model_should_match_hand_table(void) {
     EXPECT_REL(r->work, t.work, 1e-9, 1e-12);
     EXPECT_REL(r->heat, t.heat, 1e-9, 1e-12);
     EXPECT_REL(r->heat + r->work, t.rate, 1e-9, 1e-12);
+    // the positive work rate in W: F_CE |vM| when shortening (row 1: 400 N x 0.2 m/s = 80 W)
+    double w_expected = r->in.fiber_velocity < 0 && r->in.active_force > 0
+                            ? -r->in.active_force * r->in.fiber_velocity
+                            : 0.0;
+    EXPECT_REL(w_expected, t.work_power, 1e-9, 1e-12);
   }
+  EXPECT_REL(80.0, table[0].work * table[0].mus->mass, 1e-12, 1e-12);
   // the hand values themselves (guards against a typo in an expression above)
   EXPECT_REL(140.0104633, table[0].power, 1e-9, 1e-12);
   EXPECT_REL(36.0127814, table[1].power, 1e-8, 1e-12);

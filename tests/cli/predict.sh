@@ -3,9 +3,10 @@
 # as the guess, 5 nodes, 3 Ipopt iterations; the solve stops short (exit 3), the best iterate is
 # polished towards the dynamics (violation down 10-fold from the guess's; from this far the
 # polish does not reach feasibility), every file is written (metabolics.sto: the muscles and
-# their total; knee_contact.sto: both knees) and summary.json carries the prediction figures and
-# the peak knee contact of both knees; a prediction from it without --nodes solves on its 5
-# nodes; bad usage exits 2, a missing guess exits 1 with one line naming the folder.
+# their total; knee_contact.sto: both knees) and summary.json carries the prediction figures, the
+# peak knee contact of both knees and the muscles' positive work and efficiency; a prediction from
+# it without --nodes solves on its 5 nodes; bad usage exits 2, a missing guess exits 1 with one
+# line naming the folder.
 # usage: predict.sh GAITSIM SOURCE_DIR
 set -u
 gaitsim=$1 src=$2
@@ -47,6 +48,11 @@ ok = (s["problem"] == "prediction" and s["speed_target_mps"] == 0.8
       and abs(s["stride_length_m"] / s["stride_time_s"] - 0.8) <= max(1e-4, s["max_violation"])
       and s["max_violation"] * 10 <= s["initial_violation"]
       and math.isfinite(s["cost_of_transport_j_per_kg_m"]) and s["cost_of_transport_j_per_kg_m"] > 0
+      # the fibres' positive work per metre over the muscles' metabolic energy per metre: a
+      # share in (0, 1), since Umberger's heat is at least 1 W/kg of muscle
+      and 0 < s["muscle_efficiency"] < 1
+      and abs(s["muscle_efficiency"] * s["cost_of_transport_exact_j_per_kg_m"]
+              - s["muscle_positive_work_j_per_kg_m"]) <= 1e-9
       and s["polish"]["used"] and set(s["peak_excitation"]) >= {"soleus", "gasmed"}
       and all(s[f"peak_knee_contact_{k}_n"] > 0
               and abs(s[f"peak_knee_contact_{k}_bw"] * s["body_weight_n"]

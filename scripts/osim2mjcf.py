@@ -108,6 +108,17 @@ MUSCLE_DENSITY = 1059.7   # kg/m^3 (Umberger et al. 2003)
 # (40-130). That value for all six: erector spinae 0.40 kg a side, obliques 0.12 and 0.14 kg.
 TRUNK_SPECIFIC_TENSION = 0.755e6
 TRUNK_MUSCLES = ("ercspn_r", "ercspn_l", "intobl_r", "intobl_l", "extobl_r", "extobl_l")
+# Specific tension that sets the leg muscles' metabolic mass (Pa): 0.25 MPa, the stress of living
+# human knee extensors (Narici et al. 1992, Eur J Appl Physiol 65:438: 250 kN/m^2 from MRI PCSA
+# and maximum voluntary force) and the default of OpenSim's Umberger2010 probe. Umberger's heat
+# rates are per kilogram and its work is force times velocity, so Fmax / mass sets what work costs
+# in heat. The 3dpredictsim table's tensions (0.5-1.5 MPa) made the masses 35-55 % of these and the
+# heat too cheap against the work: the fibres' positive work was 0.41 of the muscles' energy at
+# 2.0 m/s, where muscle turns chemical energy into positive work at about 0.25 (Margaria 1968, Int
+# Z Angew Physiol 25:339). Legs 9.5 kg (right) and 11.7 kg (left), against 7.4 kg a leg in
+# Handsfield et al. 2014's mean MRI volumes (J Biomech 47:631; 3.7 and 4.2 kg before). The
+# slow-twitch fractions are the table's.
+LEG_SPECIFIC_TENSION = 0.25e6
 VMAX = 10.0               # lopt/s
 TAU_ACT = 0.010           # s
 TAU_DEACT = 0.040         # s
@@ -2490,9 +2501,8 @@ class Converter:
         return out
 
     def actuator_user(self, mus):
-        st, sigma = self.metabolic[metabolic_key(mus["name"])]
-        if mus["name"] in TRUNK_MUSCLES:
-            sigma = TRUNK_SPECIFIC_TENSION
+        st, _ = self.metabolic[metabolic_key(mus["name"])]
+        sigma = TRUNK_SPECIFIC_TENSION if mus["name"] in TRUNK_MUSCLES else LEG_SPECIFIC_TENSION
         mass = mus["fmax"] / sigma * mus["lopt"] * MUSCLE_DENSITY
         return [mus["fmax"], mus["lopt"], mus["lts"], mus["pennation"], VMAX, st, sigma, mass,
                 1.0 if mus["lts"] >= mus["lopt"] else 0.0, TAU_ACT, TAU_DEACT, TENDON_KT]
@@ -2511,9 +2521,12 @@ class Converter:
         out.append("  Source: %s from gilserrancoli/ReducePoly_forMSK (MIT licence)," % self.osim_name)
         out.append("    Knee Grand Challenge subject JW (right TKA, instrumented eTibia),")
         out.append("    Fregly et al. 2012, J Orthop Res 30:503. Metabolic muscle parameters:")
-        out.append("    antoinefalisse/3dpredictsim (MIT), Uchida et al. 2016; trunk muscles'")
-        out.append("    specific tension %s MPa (Burkhart et al. 2018, J Orthop Res 36:498)." % fmt(
-            TRUNK_SPECIFIC_TENSION / 1e6))
+        out.append("    antoinefalisse/3dpredictsim (MIT), Uchida et al. 2016 (slow-twitch")
+        out.append("    fractions); the metabolic masses from the specific tension %s MPa (legs;"
+                   % fmt(LEG_SPECIFIC_TENSION / 1e6))
+        out.append("    Narici et al. 1992) and %s MPa (trunk; Burkhart et al. 2018, J Orthop"
+                   % fmt(TRUNK_SPECIFIC_TENSION / 1e6))
+        out.append("    Res 36:498).")
         out.append("  %d DOF (hinge/slide only), %d muscles, total mass %s kg." % (
             len(MODEL_COORDINATES), len(m.muscles), fmt(total_mass, 6)))
         out.append("  Frames: body 'ground' rotates OpenSim's Y-up ground (X forward, Y up, Z right)")

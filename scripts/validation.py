@@ -26,6 +26,7 @@ from report import PAPER_MEASURED_STRIDE_TIME, PAPER_STRIDE_TIME, TABLE1  # noqa
 
 CAL = 4.184             # J per cal
 BASAL_W_PER_KG = 1.2    # basal rate added to the model's muscle power for its gross cost (W/kg)
+MUSCLE_EFFICIENCY = 0.25  # positive work / metabolic energy of human muscle (Margaria 1968) (-)
 # speed (m/s): the paper's (predicted, measured mean) stride time (s), from the report's lists
 PAPER_STRIDE = {v: (t, dict(PAPER_MEASURED_STRIDE_TIME)[v]) for v, t in PAPER_STRIDE_TIME}
 KNEE_PEAK_LIMIT = {0.8: 2.8, 2.0: 3.5}                 # issue #20 item 5 (BW)
@@ -145,6 +146,13 @@ def cost_across_speeds(sums):
          "U-shaped, minimum at 1.0-1.6 m/s",
          ("yes" if u_shape else "no") + f" (model's minimum at {fmt(v[kmin], 1)} m/s, "
          f"Ralston's at {fmt(v[kral], 1)})"])
+    eff = [(s["speed_target_mps"], s["muscle_efficiency"]) for s in sums
+           if s.get("speed_target_mps") and s.get("muscle_efficiency") is not None]
+    if eff:
+        row(["muscles' positive work over their metabolic energy (summary.json muscle_efficiency)",
+             ", ".join(f"{fmt(x, 1)}: {fmt(e)}" for x, e in eff),
+             f"about {MUSCLE_EFFICIENCY} (human muscle, Margaria 1968; a reference, not a target)",
+             "-"])
     print()
     if len(v) >= 3:
         a, b = fit_ralston_form(v, [n + BASAL_W_PER_KG for n in net])
@@ -238,7 +246,10 @@ def main(argv):
               f"v in m/min; the model's gross rate adds a basal {BASAL_W_PER_KG} W/kg to its "
               "muscles' (Umberger 2010).")
         print("- Umberger BR (2010). Stance and swing phase costs in human walking. J R Soc "
-              "Interface 7:1329-1340: the model's muscle energy rates.\n")
+              "Interface 7:1329-1340: the model's muscle energy rates.")
+        print("- Margaria R (1968). Positive and negative work performances and their efficiencies "
+              "in human locomotion. Int Z Angew Physiol 25:339-351: muscle's efficiency in "
+              f"positive work about {MUSCLE_EFFICIENCY}.\n")
     except PrepError as e:
         print(f"validation: {e}", file=sys.stderr)
         return 1

@@ -3,7 +3,8 @@
 # whose feet stand at z = 0.25 / 0.10 m and a tracking solution at 0.30 / 0.05 m (stance width
 # 15.0 against 25.0 cm: +10.0, missed); Table 1 rows compared with the paper's participant 2;
 # predictions at 0.8 and 2.0 m/s with Ralston's gross rate (29 + 0.0053 v^2 cal/(kg min), v in
-# m/min: 2.87 and 7.34 W/kg) and the fast/slow soleus ratio (0.6 / 0.3 = 2.00), and issue 20
+# m/min: 2.87 and 7.34 W/kg), the fast/slow soleus ratio (0.6 / 0.3 = 2.00), the muscles'
+# efficiency by speed beside Margaria's 0.25 (summary.json muscle_efficiency), and issue 20
 # item 4's checks across 0.8, 1.2 and 2.0 m/s (net power 2.00, 2.64, 7.00 W/kg rising; gross CoT
 # (net + 1.2) / v 4.00, 3.20, 4.10 J/(kg m), lowest at 1.2 m/s: U-shaped; gross power 3.20,
 # 3.84, 8.20 W/kg in Ralston's form a + b v^2 by least squares: 1.96 + 1.54 v^2, Ralston's
@@ -29,14 +30,16 @@ json.dump({"problem": "tracking", "trial": "trial", "nodes": 80, "status": "opti
                    "grf_ml_bw": 0.03, "joint_rot_deg": 2.5, "knee_contact_bw": 0.24,
                    "knee_medial_bw": 0.29, "knee_lateral_bw": 0.31}},
           open("results/track/summary.json", "w"))
-for v, T, cot, kr, kl, sol in ((0.8, 1.40, 2.5, 2.7, 2.9, 0.3), (1.2, 1.10, 2.2, 2.5, 2.5, 0.4),
-                               (2.0, 0.95, 3.5, 3.0, 3.2, 0.6)):
+for v, T, cot, kr, kl, sol, eff in ((0.8, 1.40, 2.5, 2.7, 2.9, 0.3, 0.15),
+                                    (1.2, 1.10, 2.2, 2.5, 2.5, 0.4, 0.2),
+                                    (2.0, 0.95, 3.5, 3.0, 3.2, 0.6, 0.27)):
     d = f"results/sweep/predict_{v:g}"
     os.makedirs(d)
     json.dump({"problem": "prediction", "speed_target_mps": v, "nodes": 80,
                "status": "optimal solution found", "stride_time_s": T,
                "cost_of_transport_j_per_kg_m": cot, "peak_knee_contact_r_bw": kr,
-               "peak_knee_contact_l_bw": kl, "peak_excitation": {"soleus": sol}},
+               "peak_knee_contact_l_bw": kl, "peak_excitation": {"soleus": sol},
+               "muscle_efficiency": eff},
               open(os.path.join(d, "summary.json"), "w"))
 PY
 out=$(/usr/bin/python3 "$src/scripts/validation.py" results)
@@ -56,6 +59,9 @@ check "net power rises" grep -qF "| net power by speed (W/kg) | 0.8: 2.00, 1.2: 
 check "CoT 2.0 above 1.2" grep -qF "| net CoT 2.0 against 1.2 m/s (J/(kg m)) | 3.50 against 2.20 | 2.0 higher | yes |" <<<"$out"
 check "Ralston's form" grep -qF "3 speeds: 1.96 + 1.54 v^2 W/kg (v in m/s), Ralston's 2.02 + 1.33 v^2" <<<"$out"
 check "gross CoT U-shaped" grep -qF "0.8: 4.00, 1.2: 3.20, 2.0: 4.10; 0.8: 3.59, 1.2: 3.28, 2.0: 3.67 | U-shaped, minimum at 1.0-1.6 m/s | yes (model's minimum at 1.2 m/s, Ralston's at 1.2) |" <<<"$out"
+
+check "muscle efficiency by speed" grep -qF "| 0.8: 0.15, 1.2: 0.20, 2.0: 0.27 | about 0.25 (human muscle, Margaria 1968; a reference, not a target) | - |" <<<"$out"
+check "Margaria cited" grep -qF "Margaria R (1968)" <<<"$out"
 
 rm results/track/summary.json
 err=$(/usr/bin/python3 "$src/scripts/validation.py" results 2>&1 >/dev/null)

@@ -20,9 +20,9 @@
 #define GO_MAX_ITER 2500           // each prediction: gaitsim predict, each speed of sweep and of
                                    // run's main job (--max-iter). An iteration budget, not a time
                                    // limit, so results do not depend on the load of the machine;
-                                   // at 80 nodes the main job's predictions stop after 541
-                                   // (0.8 m/s) and 717 (2.0 m/s) iterations; other starts took
-                                   // up to 1807 (docs/BENCHMARKS.md)
+                                   // at 80 nodes the main job's predictions stop after 1406
+                                   // (0.8 m/s) and 1055 (2.0 m/s) iterations; other starts took
+                                   // up to 1852 (docs/BENCHMARKS.md)
 #define GO_MAX_ITER_TRACK 60       // track's main solve, Gauss-Newton from the trial's guess at
                                    // barrier GO_GN_MU_INIT, before the refinement (--max-iter).
                                    // At N = 80 it brings the violation from 182 to about 0.1 at

@@ -1737,11 +1737,14 @@ def assign_wraps(model, muscle, kept_points, x0):
 # ------------------------------------------------------------------------------------------------
 
 def read_metabolic(path):
+    """Each muscle's slow-twitch fibre fraction (-) from the 3dpredictsim table. Its
+    specific_tension_MPa column is not read: the metabolic mass takes LEG_SPECIFIC_TENSION and
+    TRUNK_SPECIFIC_TENSION instead (mjmodels/README.md, "The leg muscles' specific tension")."""
     out = {}
     with open(path) as f:
         rows = list(csv.DictReader(line for line in f if not line.startswith("#")))
     for r in rows:
-        out[r["muscle"]] = (float(r["pct_slow_twitch"]), float(r["specific_tension_MPa"]) * 1e6)
+        out[r["muscle"]] = float(r["pct_slow_twitch"])
     return out
 
 
@@ -2501,7 +2504,7 @@ class Converter:
         return out
 
     def actuator_user(self, mus):
-        st, _ = self.metabolic[metabolic_key(mus["name"])]
+        st = self.metabolic[metabolic_key(mus["name"])]
         sigma = TRUNK_SPECIFIC_TENSION if mus["name"] in TRUNK_MUSCLES else LEG_SPECIFIC_TENSION
         mass = mus["fmax"] / sigma * mus["lopt"] * MUSCLE_DENSITY
         return [mus["fmax"], mus["lopt"], mus["lts"], mus["pennation"], VMAX, st, sigma, mass,

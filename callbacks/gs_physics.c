@@ -7,6 +7,7 @@
 
 #include "callbacks/gs_activation.h"
 #include "callbacks/gs_coupling.h"
+#include "callbacks/gs_joint_limits.h"
 #include "callbacks/gs_knee.h"
 #include "callbacks/gs_model_info.h"
 #include "callbacks/gs_model_layout.h"
@@ -196,13 +197,15 @@ void gs_physics_foot_grf(const mjModel* m, const mjData* d, int side, double fn_
   gs_contact_foot_grf(n, forces, points, NULL, NULL, fn_min, grf);
 }
 
-// mjcb_passive: foot-ground contact, and the implant knee's surrogate contact and ligaments when
+// mjcb_passive: foot-ground contact, the implant knee's surrogate contact and ligaments when
 // the model carries the gs_knee numerics (callbacks/gs_knee.h; a no-op otherwise; the knee's
-// parameters were cached by gs_physics_prepare, gs_knee_register)
+// parameters were cached by gs_physics_prepare, gs_knee_register), the coordinate couplings and
+// the joint-limit moments (callbacks/gs_joint_limits.h)
 static void gs_passive_callback(const mjModel* m, mjData* d) {
   gs_physics_contact_passive(m, d);
   gs_knee_passive(m, d, NULL);
   gs_coupling_passive(m, d);
+  gs_joint_limits_passive(m, d);
 }
 
 int gs_physics_prepare(mjModel* m, char* err, int errsz) {
@@ -253,6 +256,8 @@ int gs_physics_prepare(mjModel* m, char* err, int errsz) {
   }
   // coordinate couplings (the right patella's): held by mjcb_passive, not by MuJoCo's solver
   if (gs_coupling_adopt(m, err, errsz) < 0) return -1;
+  // joint-limit moments: their numerics checked once here
+  if (gs_joint_limits_check(m, err, errsz) < 0) return -1;
   // implant knee: numerics checked and cached once here, so that mjcb_passive finds them by the
   // model pointer instead of by name on every call (gs_knee_register; no-op for other models)
   char why[256];

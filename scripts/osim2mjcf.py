@@ -119,6 +119,21 @@ TRUNK_MUSCLES = ("ercspn_r", "ercspn_l", "intobl_r", "intobl_l", "extobl_r", "ex
 # Handsfield et al. 2014's mean MRI volumes (J Biomech 47:631; 3.7 and 4.2 kg before). The
 # slow-twitch fractions are the table's.
 LEG_SPECIFIC_TENSION = 0.25e6
+
+# Passive moments at the ends of the joints' ranges (callbacks/gs_joint_limits.h; mjmodels/README.md,
+# "Joint-limit moments"): tau = k1 exp(k2 (q - theta2)) + k3 exp(k4 (q - theta1)) (N m, q in rad),
+# Anderson & Pandy 1999's form with the coefficients of Falisse et al. 2019 (J R Soc Interface
+# 16:20190402; their 3D model, antoinefalisse/3dpredictsim, MIT), both legs alike (the .osim's
+# coordinate conventions are gait2392's, theirs).
+# JW's .osim has none: its knees hyperextended by 12-17 deg in the predictions (the coordinate
+# range reaches +20 deg), standing on locked knees with idle vasti.
+# Only the knees: Falisse's lumbar flexion limit (-30 deg) lies inside JW's flexed trunk (-27 to
+# -32 deg in the trial) and the tracking hung the trunk on it (84 N m of support the effort goal
+# does not price; docs/BENCHMARKS.md, "Joint-limit moments"); their hip, ankle and subtalar laws
+# give under 0.5 N m over the trials.
+JOINT_LIMIT_MOMENTS = (  # coordinate, (k1, k2, k3, k4), (theta1, theta2)
+    ("knee_flexion", (-6.09, 33.94, 11.03, -11.33), (-2.4, 0.13)),
+)
 VMAX = 10.0               # lopt/s
 TAU_ACT = 0.010           # s
 TAU_DEACT = 0.040         # s
@@ -2637,6 +2652,16 @@ class Converter:
                            mus["name"], mus["name"], fmt(mus["fmax"]), fvec(lr, 6),
                            fvec(self.actuator_user(mus))))
         out.append("  </actuator>")
+        out.append("  <custom>")
+        for coordinate, k, theta in JOINT_LIMIT_MOMENTS:
+            sides = [""] if coordinate.startswith("lumbar") else ["", "_l"]
+            for side in sides:
+                if coordinate + side not in MODEL_COORDINATES:
+                    raise SystemExit("osim2mjcf.py: joint-limit moment for %s: no such "
+                                     "coordinate" % (coordinate + side))
+                out.append('    <numeric name="gs_limit_%s%s" size="6" data="%s"/>' % (
+                    coordinate, side, " ".join(repr(v) for v in k + theta)))
+        out.append("  </custom>")
         qpos = []
         for c in MODEL_COORDINATES:
             qpos.append(self.standing[c])

@@ -2,8 +2,9 @@
 //
 // gaitsim adds to MuJoCo, through its callbacks, the physics MuJoCo lacks for human gait:
 // Hill-type muscle-tendon units (rigid or elastic tendon) with first-order activation dynamics,
-// smooth Hunt-Crossley foot-ground contact spheres, and, in models that carry it, the implant
-// knee's contact surrogate and ligaments. Models are gaitsim's MJCF files (the project's
+// smooth Hunt-Crossley foot-ground contact spheres, passive moments at the knees' extension
+// limits (gs_limit_* numerics), and, in models that carry it, the implant knee's contact
+// surrogate and ligaments. Models are gaitsim's MJCF files (the project's
 // mjmodels/): parameters sit in actuator `user` rows and `numeric` elements, which stock MuJoCo
 // ignores. Typical use:
 //
@@ -56,8 +57,8 @@ GS_LIB_API const char* gs_lib_version(void);
 
 // Switch model m to gaitsim's physics: its muscles get gaitsim's gain, bias and activation
 // dynamics; MuJoCo's own contact solver is disabled (the foot spheres become gaitsim's smooth
-// contact); nuserdata grows to nu. Checks every muscle's and contact sphere's parameters and the
-// implant-knee numerics when present. Call before mj_makeData. Returns 0, or -1 with the reason
+// contact); nuserdata grows to nu. Checks every muscle's and contact sphere's parameters, the
+// joint-limit laws and the implant-knee numerics when present. Call before mj_makeData. Returns 0, or -1 with the reason
 // (naming the actuator, geom or numeric) in err.
 GS_LIB_API int gs_lib_prepare(mjModel* m, char* err, int errsz);
 

@@ -49,7 +49,7 @@ static const char* kRunUsage =
     GO_STR(GO_MAX_ITER) ": an iteration\n"
     "                 budget, not a time limit, so that the results do not depend on the load\n"
     "                 of the machine; in the main job (docs/BENCHMARKS.md) they settle\n"
-    "                 after 1406 (0.8 m/s) and 1055 (2.0 m/s) iterations, about 1 s each on\n"
+    "                 after 840 (0.8 m/s) and 1660 (2.0 m/s) iterations, about 1 s each on\n"
     "                 one core)\n"
     "  --nodes N      collocation nodes of every solve (default " GO_STR(GO_NODES_MAIN_JOB)
     "; 20 gives a coarse\n"

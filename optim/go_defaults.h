@@ -20,8 +20,8 @@
 #define GO_MAX_ITER 2500           // each prediction: gaitsim predict, each speed of sweep and of
                                    // run's main job (--max-iter). An iteration budget, not a time
                                    // limit, so results do not depend on the load of the machine;
-                                   // at 80 nodes the main job's predictions stop after 1406
-                                   // (0.8 m/s) and 1055 (2.0 m/s) iterations; other starts took
+                                   // at 80 nodes the main job's predictions stop after 840
+                                   // (0.8 m/s) and 1660 (2.0 m/s) iterations; other starts took
                                    // up to 1852 (docs/BENCHMARKS.md)
 #define GO_MAX_ITER_TRACK 60       // track's main solve, Gauss-Newton from the trial's guess at
                                    // barrier GO_GN_MU_INIT, before the refinement (--max-iter).

@@ -129,8 +129,8 @@ LEG_SPECIFIC_TENSION = 0.25e6
 # range reaches +20 deg), standing on locked knees with idle vasti.
 # Only the knees: Falisse's lumbar flexion limit (-30 deg) lies inside JW's flexed trunk (-27 to
 # -32 deg in the trial) and the tracking hung the trunk on it (84 N m of support the effort goal
-# does not price; docs/BENCHMARKS.md, "Joint-limit moments"); their hip, ankle and subtalar laws
-# give under 0.5 N m over the trials.
+# does not price; docs/BENCHMARKS.md, "Joint-limit moments at the knees"); their hip, ankle and
+# subtalar laws give under 0.5 N m over the trials.
 JOINT_LIMIT_MOMENTS = (  # coordinate, (k1, k2, k3, k4), (theta1, theta2)
     ("knee_flexion", (-6.09, 33.94, 11.03, -11.33), (-2.4, 0.13)),
 )

@@ -30,6 +30,13 @@ MUSCLE_EFFICIENCY = 0.25  # positive work / metabolic energy of human muscle (Ma
 # speed (m/s): the paper's (predicted, measured mean) stride time (s), from the report's lists
 PAPER_STRIDE = {v: (t, dict(PAPER_MEASURED_STRIDE_TIME)[v]) for v, t in PAPER_STRIDE_TIME}
 KNEE_PEAK_LIMIT = {0.8: 2.8, 2.0: 3.5}                 # issue #20 item 5 (BW)
+SWEEP_SPEEDS = (0.8, 1.0, 1.2, 1.4, 1.6, 1.8, 2.0)     # issue #20 item 4's sweep (m/s)
+# the solver statuses (optim/go_ipopt.c go_solve_status_str) of a solve that reached its answer
+CONVERGED_STATUSES = ("optimal solution found", "solved to acceptable level", "objective settled")
+
+
+def converged(status):
+    return status in CONVERGED_STATUSES
 
 
 def ralston_gross_w_per_kg(v):
@@ -127,6 +134,11 @@ def cost_across_speeds(sums):
     gross_cot = [(n + BASAL_W_PER_KG) / x for n, x in zip(net, v)]
     ral_cot = [ralston_gross_w_per_kg(x) / x for x in v]
     by = {round(x, 1): c for x, c in pts}
+    # the checks hold for the speeds shown; say so when the sweep is incomplete or unsettled
+    missing = [x for x in SWEEP_SPEEDS if x not in by]
+    short = [f"{fmt(s['speed_target_mps'], 1)} ({s.get('status')})" for s in sums
+             if s.get("speed_target_mps") and not converged(s.get("status"))]
+    caveat = " (provisional)" if missing or short else ""
     kmin = min(range(len(v)), key=lambda k: gross_cot[k])
     kral = min(range(len(v)), key=lambda k: ral_cot[k])
     print("Cost across speeds (#20 item 4): gross cost of transport = (net power + basal "
@@ -135,16 +147,16 @@ def cost_across_speeds(sums):
     row(["---"] * 4)
     rises = all(b > a for a, b in zip(net, net[1:]))
     row(["net power by speed (W/kg)", ", ".join(f"{fmt(x, 1)}: {fmt(n)}" for x, n in zip(v, net)),
-         "rises at every step", "yes" if rises else "no"])
+         "rises at every step", ("yes" if rises else "no") + caveat])
     if 1.2 in by and 2.0 in by:
         row(["net CoT 2.0 against 1.2 m/s (J/(kg m))", f"{fmt(by[2.0])} against {fmt(by[1.2])}",
-             "2.0 higher", "yes" if by[2.0] > by[1.2] else "no"])
+             "2.0 higher", ("yes" if by[2.0] > by[1.2] else "no") + caveat])
     u_shape = 0 < kmin < len(v) - 1 and 1.0 <= v[kmin] <= 1.6
     row(["gross CoT by speed (J/(kg m)); Ralston's",
          ", ".join(f"{fmt(x, 1)}: {fmt(g)}" for x, g in zip(v, gross_cot)) +
          "; " + ", ".join(f"{fmt(x, 1)}: {fmt(r)}" for x, r in zip(v, ral_cot)),
          "U-shaped, minimum at 1.0-1.6 m/s",
-         ("yes" if u_shape else "no") + f" (model's minimum at {fmt(v[kmin], 1)} m/s, "
+         ("yes" if u_shape else "no") + caveat + f" (model's minimum at {fmt(v[kmin], 1)} m/s, "
          f"Ralston's at {fmt(v[kral], 1)})"])
     eff = [(s["speed_target_mps"], s["muscle_efficiency"]) for s in sums
            if s.get("speed_target_mps") and s.get("muscle_efficiency") is not None]
@@ -154,6 +166,11 @@ def cost_across_speeds(sums):
              f"about {MUSCLE_EFFICIENCY} (human muscle, Margaria 1968; a reference, not a target)",
              "-"])
     print()
+    if caveat:
+        print("Provisional: the checks above hold for the speeds shown only"
+              + (f"; not solved: {', '.join(fmt(x, 1) for x in missing)} m/s" if missing else "")
+              + (f"; stopped short of convergence: {', '.join(short)}" if short else "")
+              + ".\n")
     if len(v) >= 3:
         a, b = fit_ralston_form(v, [n + BASAL_W_PER_KG for n in net])
         a_r, b_r = ralston_gross_w_per_kg(0.0), ralston_gross_w_per_kg(1.0) - \

@@ -6,7 +6,8 @@
 # m/min: 2.87 and 7.34 W/kg), the fast/slow soleus ratio (0.6 / 0.3 = 2.00), the muscles'
 # efficiency by speed beside Margaria's 0.25 (summary.json muscle_efficiency), and issue 20
 # item 4's checks across 0.8, 1.2 and 2.0 m/s (net power 2.00, 2.64, 7.00 W/kg rising; gross CoT
-# (net + 1.2) / v 4.00, 3.20, 4.10 J/(kg m), lowest at 1.2 m/s: U-shaped; gross power 3.20,
+# (net + 1.2) / v 4.00, 3.20, 4.10 J/(kg m), lowest at 1.2 m/s: U-shaped, each check marked
+# provisional since 1.0, 1.4, 1.6 and 1.8 m/s are missing; gross power 3.20,
 # 3.84, 8.20 W/kg in Ralston's form a + b v^2 by least squares: 1.96 + 1.54 v^2, Ralston's
 # 29 cal/(kg min) = 2.02 W/kg + 0.0053 x 3600 cal/(kg min) = 1.33 W/kg per (m/s)^2); a missing
 # track summary exits 1 with one line naming the file.
@@ -55,10 +56,11 @@ check "0.8 m/s row" grep -qF "| 0.8 | 80, optimal solution found | 1.400 (-3.4 %
 # 2.0 m/s: net 7.00, gross 8.20 against 7.34 (+12 %)
 check "2.0 m/s row" grep -qF "| 2.0 | 80, optimal solution found | 0.950 (+2.2 % of measured) | 0.92 / 0.93 | 3.50 | 7.00 | 8.20 | 7.34 | yes | 3.00 / 3.20 | yes |" <<<"$out"
 check "soleus ratio 2.00" grep -qF "soleus 2.00" <<<"$out"
-check "net power rises" grep -qF "| net power by speed (W/kg) | 0.8: 2.00, 1.2: 2.64, 2.0: 7.00 | rises at every step | yes |" <<<"$out"
-check "CoT 2.0 above 1.2" grep -qF "| net CoT 2.0 against 1.2 m/s (J/(kg m)) | 3.50 against 2.20 | 2.0 higher | yes |" <<<"$out"
+check "net power rises" grep -qF "| net power by speed (W/kg) | 0.8: 2.00, 1.2: 2.64, 2.0: 7.00 | rises at every step | yes (provisional) |" <<<"$out"
+check "CoT 2.0 above 1.2" grep -qF "| net CoT 2.0 against 1.2 m/s (J/(kg m)) | 3.50 against 2.20 | 2.0 higher | yes (provisional) |" <<<"$out"
+check "three of the sweep's seven speeds: provisional" grep -qF "Provisional: the checks above hold for the speeds shown only; not solved: 1.0, 1.4, 1.6, 1.8 m/s." <<<"$out"
 check "Ralston's form" grep -qF "3 speeds: 1.96 + 1.54 v^2 W/kg (v in m/s), Ralston's 2.02 + 1.33 v^2" <<<"$out"
-check "gross CoT U-shaped" grep -qF "0.8: 4.00, 1.2: 3.20, 2.0: 4.10; 0.8: 3.59, 1.2: 3.28, 2.0: 3.67 | U-shaped, minimum at 1.0-1.6 m/s | yes (model's minimum at 1.2 m/s, Ralston's at 1.2) |" <<<"$out"
+check "gross CoT U-shaped" grep -qF "0.8: 4.00, 1.2: 3.20, 2.0: 4.10; 0.8: 3.59, 1.2: 3.28, 2.0: 3.67 | U-shaped, minimum at 1.0-1.6 m/s | yes (provisional) (model's minimum at 1.2 m/s, Ralston's at 1.2) |" <<<"$out"
 
 check "muscle efficiency by speed" grep -qF "| 0.8: 0.15, 1.2: 0.20, 2.0: 0.27 | about 0.25 (human muscle, Margaria 1968; a reference, not a target) | - |" <<<"$out"
 check "Margaria cited" grep -qF "Margaria R (1968)" <<<"$out"

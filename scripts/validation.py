@@ -190,7 +190,7 @@ def predictions(folders):
     if not sums:
         return
     sums.sort(key=lambda s: s.get("speed_target_mps", 0))
-    print(f"## Predictions: minimum cost of transport, free stride time\n")
+    print("## Predictions: minimum cost of transport, free stride time\n")
     print("Stride time against the paper's predicted and JW's measured means (target, #20 item 4: "
           "within 5 % of the measured). Net cost: the model's muscles (smooth Umberger 2010); "
           f"gross: plus a basal {BASAL_W_PER_KG} W/kg, against Ralston 1958's gross rate "

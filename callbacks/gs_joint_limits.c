@@ -6,7 +6,8 @@
 #include <string.h>
 
 double gs_joint_limit_moment(const double k[4], const double theta[2], double q, double* dtau_dq) {
-  // Anderson & Pandy 1999; Falisse et al. 2019: tau = k1 e^(k2 (q - theta2)) + k3 e^(k4 (q - theta1))
+  // Anderson & Pandy 1999; Falisse et al. 2019:
+  // tau = k1 e^(k2 (q - theta2)) + k3 e^(k4 (q - theta1))
   double upper = k[0] * exp(k[1] * (q - theta[1]));
   double lower = k[2] * exp(k[3] * (q - theta[0]));
   if (dtau_dq) *dtau_dq = k[1] * upper + k[3] * lower;

@@ -120,11 +120,12 @@ TRUNK_MUSCLES = ("ercspn_r", "ercspn_l", "intobl_r", "intobl_l", "extobl_r", "ex
 # slow-twitch fractions are the table's.
 LEG_SPECIFIC_TENSION = 0.25e6
 
-# Passive moments at the ends of the joints' ranges (callbacks/gs_joint_limits.h; mjmodels/README.md,
-# "Joint-limit moments"): tau = k1 exp(k2 (q - theta2)) + k3 exp(k4 (q - theta1)) (N m, q in rad),
-# Anderson & Pandy 1999's form with the coefficients of Falisse et al. 2019 (J R Soc Interface
-# 16:20190402; their 3D model, antoinefalisse/3dpredictsim, MIT), both legs alike (the .osim's
-# coordinate conventions are gait2392's, theirs).
+# Passive moments at the ends of the joints' ranges (callbacks/gs_joint_limits.h;
+# mjmodels/README.md, "Joint-limit moments"): tau = k1 exp(k2 (q - theta2)) + k3 exp(k4 (q -
+# theta1)) (N m, q in rad), Anderson & Pandy 1999's form with the coefficients of Falisse et al.
+# 2019 (J R Soc Interface 16:20190402; their 3D model, antoinefalisse/3dpredictsim, MIT). Each row
+# names a leg coordinate (the right's name) and is written for both legs alike, COORD and COORD_l
+# (the .osim's coordinate conventions are gait2392's, theirs).
 # JW's .osim has none: its knees hyperextended by 12-17 deg in the predictions (the coordinate
 # range reaches +20 deg), standing on locked knees with idle vasti.
 # Only the knees: Falisse's lumbar flexion limit (-30 deg) lies inside JW's flexed trunk (-27 to
@@ -2654,8 +2655,7 @@ class Converter:
         out.append("  </actuator>")
         out.append("  <custom>")
         for coordinate, k, theta in JOINT_LIMIT_MOMENTS:
-            sides = [""] if coordinate.startswith("lumbar") else ["", "_l"]
-            for side in sides:
+            for side in ("", "_l"):  # both legs alike
                 if coordinate + side not in MODEL_COORDINATES:
                     raise SystemExit("osim2mjcf.py: joint-limit moment for %s: no such "
                                      "coordinate" % (coordinate + side))

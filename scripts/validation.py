@@ -31,7 +31,7 @@ MUSCLE_EFFICIENCY = 0.25  # positive work / metabolic energy of human muscle (Ma
 PAPER_STRIDE = {v: (t, dict(PAPER_MEASURED_STRIDE_TIME)[v]) for v, t in PAPER_STRIDE_TIME}
 KNEE_PEAK_LIMIT = {0.8: 2.8, 2.0: 3.5}                 # issue #20 item 5 (BW)
 SWEEP_SPEEDS = (0.8, 1.0, 1.2, 1.4, 1.6, 1.8, 2.0)     # issue #20 item 4's sweep (m/s)
-# the solver statuses (optim/go_ipopt.c go_solve_status_str) of a solve that reached its answer
+# the statuses optim/go_solve.c's solve_converged counts as converged (go_solve_status_str's texts)
 CONVERGED_STATUSES = ("optimal solution found", "solved to acceptable level", "objective settled")
 
 

@@ -58,8 +58,8 @@ GS_LIB_API const char* gs_lib_version(void);
 // Switch model m to gaitsim's physics: its muscles get gaitsim's gain, bias and activation
 // dynamics; MuJoCo's own contact solver is disabled (the foot spheres become gaitsim's smooth
 // contact); nuserdata grows to nu. Checks every muscle's and contact sphere's parameters, the
-// joint-limit laws and the implant-knee numerics when present. Call before mj_makeData. Returns 0, or -1 with the reason
-// (naming the actuator, geom or numeric) in err.
+// joint-limit laws and the implant-knee numerics when present. Call before mj_makeData. Returns
+// 0, or -1 with the reason (naming the actuator, geom or numeric) in err.
 GS_LIB_API int gs_lib_prepare(mjModel* m, char* err, int errsz);
 
 // Install gaitsim's callbacks (process-global). Idempotent. Call once before threads start.

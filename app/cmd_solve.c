@@ -1246,6 +1246,9 @@ static int solve(gsTrackOptions o) {
     cJSON_AddStringToObject(summary, "trial", o.trial);
   }
   cJSON_AddStringToObject(summary, "status", go_solve_status_str(res->status));
+  // the project's stopping rule met (Ipopt's optimal or acceptable level, or settled): the
+  // solution is a minimum the solver vouches for, not a best iterate stopped short
+  cJSON_AddBoolToObject(summary, "converged", rep.converged);
   if (res->status == GO_SOLVE_EVAL_ERROR)  // which evaluation failed last ("": none of ours)
     cJSON_AddStringToObject(summary, "eval_error", res->eval_error);
   cJSON_AddNumberToObject(summary, "iterations", res->iterations);

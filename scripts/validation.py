@@ -31,12 +31,16 @@ MUSCLE_EFFICIENCY = 0.25  # positive work / metabolic energy of human muscle (Ma
 PAPER_STRIDE = {v: (t, dict(PAPER_MEASURED_STRIDE_TIME)[v]) for v, t in PAPER_STRIDE_TIME}
 KNEE_PEAK_LIMIT = {0.8: 2.8, 2.0: 3.5}                 # issue #20 item 5 (BW)
 SWEEP_SPEEDS = (0.8, 1.0, 1.2, 1.4, 1.6, 1.8, 2.0)     # issue #20 item 4's sweep (m/s)
-# the statuses optim/go_solve.c's solve_converged counts as converged (go_solve_status_str's texts)
+# the statuses optim/go_solve.c's solve_converged counts as converged (go_solve_status_str's
+# texts): for summary.json files written before it carried its own "converged" flag
 CONVERGED_STATUSES = ("optimal solution found", "solved to acceptable level", "objective settled")
 
 
-def converged(status):
-    return status in CONVERGED_STATUSES
+def converged(summary):
+    """Whether the solve met the project's stopping rule (summary.json's converged flag)."""
+    if "converged" in summary:
+        return bool(summary["converged"])
+    return summary.get("status") in CONVERGED_STATUSES
 
 
 def ralston_gross_w_per_kg(v):
@@ -137,7 +141,7 @@ def cost_across_speeds(sums):
     # the checks hold for the speeds shown; say so when the sweep is incomplete or unsettled
     missing = [x for x in SWEEP_SPEEDS if x not in by]
     short = [f"{fmt(s['speed_target_mps'], 1)} ({s.get('status')})" for s in sums
-             if s.get("speed_target_mps") and not converged(s.get("status"))]
+             if s.get("speed_target_mps") and not converged(s)]
     caveat = " (provisional)" if missing or short else ""
     kmin = min(range(len(v)), key=lambda k: gross_cot[k])
     kral = min(range(len(v)), key=lambda k: ral_cot[k])

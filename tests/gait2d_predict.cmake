@@ -11,9 +11,10 @@
 # a positive cost of transport, and the smooth cost of transport the solve minimises within 5 % of
 # the exact Umberger 2010 one of the same solution (summary.json cost_of_transport_exact_*: the
 # widths of predict's default --metabolic-smoothing 10 do not change the cost much). Measured
-# with the current defaults: objective settled after 311 iterations, 20 s on 2 cores, stride
-# 1.28 s, cost of transport 1.15 smooth / 1.17 exact J/(kg m) (a planar model with 18 muscles;
-# its cost is flat in stride time, so strides of 1.18-1.53 s came out of earlier versions).
+# with the current defaults and gait2d.xml: objective settled after 699 iterations, 34 s on 2
+# cores, stride 1.33 s, cost of transport 1.64 smooth / 1.64 exact J/(kg m) (a planar model
+# with 18 muscles; its cost is flat in stride time, so strides of 1.18-1.53 s came out of
+# earlier versions).
 add_test(NAME gait2d_predict_1p2
   COMMAND bash -c "set -e; out=$(mktemp -d); trap 'rm -rf $out' EXIT; \
     $<TARGET_FILE:gaitsim> track ${CMAKE_SOURCE_DIR}/mjmodels/trials/jw_ngait_og5 --out $out/track \

@@ -34,6 +34,7 @@ ok = (r.get("status") == "iteration limit reached" and r.get("iterations") == 14
       and math.isfinite(gn.get("violation", float("nan")))
       and r.get("used") is True and math.isfinite(r.get("objective", float("nan")))
       and s["iterations"] == 17 and s["status"] == "iteration limit reached"
+      and s["converged"] is False
       # wall_s counts the whole solve, the refinement not kept and the polish included
       and s["wall_s"] >= s["ipopt_wall_s"] + s.get("polish", {}).get("wall_s", 0)
       and s["ipopt_wall_s"] >= r.get("wall_s", 0)

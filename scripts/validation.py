@@ -171,10 +171,14 @@ def cost_across_speeds(sums):
              "-"])
     print()
     if caveat:
-        print("Provisional: the checks above hold for the speeds shown only"
-              + (f"; not solved: {', '.join(fmt(x, 1) for x in missing)} m/s" if missing else "")
-              + (f"; stopped short of convergence: {', '.join(short)}" if short else "")
-              + ".\n")
+        parts = []
+        if missing:
+            parts.append(f"not solved: {', '.join(fmt(x, 1) for x in missing)} m/s, so the "
+                         "checks hold for the speeds shown only")
+        if short:
+            parts.append("stopped short of convergence (best iterates, not minima: their costs "
+                         f"may still fall): {', '.join(short)}")
+        print("Provisional: " + "; ".join(parts) + ".\n")
     if len(v) >= 3:
         a, b = fit_ralston_form(v, [n + BASAL_W_PER_KG for n in net])
         a_r, b_r = ralston_gross_w_per_kg(0.0), ralston_gross_w_per_kg(1.0) - \

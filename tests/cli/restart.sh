@@ -1,20 +1,20 @@
 #!/usr/bin/env bash
 # The fall-back guard and the restarts from the best iterate, end to end on the planar model
-# (mjmodels/gait2d.xml, 20 nodes; about 50 s on 2 cores): a 100-iteration track as the guess, then
-# a prediction at 1.2 m/s with the guard made hair-trigger (--fallback-rise 1e-4: a rise of 0.01 %
+# (mjmodels/gait2d.xml, 20 nodes; about 50 s on 2 cores): a 100-iteration track as the guess, then a
+# prediction at 1.2 m/s with the guard made hair-trigger (--fallback-rise 1e-4: a rise of 0.01 %
 # above the lowest objective reached at a violation <= 1e-4 counts as a fall-back). Measured with
-# the current gait2d.xml: fall-backs after 114 and 163 iterations, both restarts used, and the
-# third solve falls back too, after 168 iterations in all (exit 3); with other muscle parameters
-# the third solve settles (exit 0), so either outcome passes. Expected: both restarts in summary.json in order
+# the current gait2d.xml: fall-backs after 114 and 163 iterations, both restarts used, and the third
+# solve falls back too, after 168 iterations in all (exit 3); with other muscle parameters the third
+# solve settles (exit 0), so either outcome passes. Expected: both restarts in summary.json in order
 # (each after more iterations than the one before, each from an iteration no later than its stop,
 # with the objective and violation of the best iterate it started from, violation <= 1e-3: the
 # best-iterate ranking's limit, go_ipopt_opts.best_viol_tol), the iterations of all three solves
-# summed, the polished result feasible to 1e-6 and less violated than the point it was polished
-# from (summary.json polish.violation_before: the settled solve's best iterate, not Ipopt's last
-# point; equal to the written violation if the polish was not used), the progress naming both
-# restarts, and the exit status the final status calls for: 3 with "fell back from the solution
-# it had reached" (the third solve fell back too), 0 with a converged status; --fallback-rise
-# with a negative value is a usage error (exit 2).
+# summed, the polished result feasible to 1e-6 and less violated than the point it was polished from
+# (summary.json polish.violation_before: the settled solve's best iterate, not Ipopt's last point;
+# equal to the written violation if the polish was not used), the progress naming both restarts, and
+# the exit status the final status calls for: 3 with "fell back from the solution it had reached"
+# (the third solve fell back too), 0 with a converged status; --fallback-rise with a negative value
+# is a usage error (exit 2).
 # usage: restart.sh GAITSIM SOURCE_DIR
 set -u
 gaitsim=$1 src=$2

@@ -15,6 +15,9 @@ RESULTS (default results) is the folder `gaitsim run` writes. Prints:
     below 1 % of its Fmax, above Umberger's 1 W/kg floor (Fmax and mass from the `user` rows of
     the model summary.json names; W, and W/kg of body mass), the five largest by name, and the
     coordinates that leave the model's joint ranges (deg, or m for slides);
+  - for the tracking solution and each prediction with a grf.mot: each knee's flexion in
+    loading response, the most flexed over the first 20 % of the stride after its foot's
+    contact (vertical ground force above 20 N; deg);
   - over three predictions or more, each group's power in Ralston's form a + b v^2 (least
     squares; W/kg, v in m/s): a, the cost per second whatever the speed, which makes the cost of
     transport fall with speed, and b; beside Ralston 1958's muscle share (his gross rate less the
@@ -69,6 +72,43 @@ def mean_over_time(t, y):
     return area / (t[-1] - t[0])
 
 
+CONTACT_N = 20.0          # a foot is on the ground above this vertical ground force (N)
+LOADING_RESPONSE = 0.2    # the stride fraction after contact searched for the knee's flexion (-)
+
+
+def loading_response_knee(folder):
+    """Each knee's largest flexion (deg, right and left) over the LOADING_RESPONSE of the
+    stride after its foot's contact (the first node where grf.mot's vertical force exceeds
+    CONTACT_N after one where it did not, the stride taken as periodic): the stance flexion
+    JW's gait has (16-20 deg tracked) and a straight-legged stance lacks. knee_flexion is
+    negative in flexion (gait2392). None without grf.mot, its columns or the knees'."""
+    grf_path = os.path.join(folder, "grf.mot")
+    if not os.path.exists(grf_path):
+        return None
+    q, g = columns(os.path.join(folder, "states.sto")), columns(grf_path)
+    flexion = []
+    for coord, force in (("knee_flexion", "ground_force_r_vy"),
+                         ("knee_flexion_l", "ground_force_l_vy")):
+        if coord not in q or force not in g:
+            return None
+        on = [interp(t, g["time"], g[force]) > CONTACT_N for t in q["time"]]
+        n = len(on)
+        starts = [k for k in range(n) if on[k] and not on[k - 1]]
+        if not starts:
+            return None
+        window = [(starts[0] + j) % n for j in range(max(1, round(LOADING_RESPONSE * n)))]
+        flexion.append(-min(q[coord][k] for k in window))
+    return flexion
+
+
+def print_loading_response_knee(folder):
+    knee = loading_response_knee(folder)
+    if knee:
+        print(f"  loading-response knee flexion (deg; the most flexed over the first "
+              f"{100 * LOADING_RESPONSE:.0f} % of the stride after contact): right "
+              f"{knee[0]:.1f}, left {knee[1]:.1f}")
+
+
 def tracking(track):
     s = read_json(os.path.join(track, "summary.json"))
     trial = s.get("trial")
@@ -86,6 +126,7 @@ def tracking(track):
         rms = (sum(x * x for x in d) / len(d)) ** 0.5
         print(f"  {c:18s} {sum(d) / len(d):+8.3f} {rms:8.3f}  {sum(model[c]) / len(d):+8.2f} "
               f"{sum(m) / len(m):+8.2f}")
+    print_loading_response_knee(track)
 
 
 def prediction(folder):
@@ -113,6 +154,7 @@ def prediction(folder):
     slack_cost(s["model"], met, columns(os.path.join(folder, "muscle_forces.sto")), mass)
     outside = outside_ranges(s["model"], columns(os.path.join(folder, "states.sto")))
     print("  joint ranges (model): " + ("; ".join(outside) if outside else "all kept"))
+    print_loading_response_knee(folder)
     return speed, power, total
 
 

@@ -15,7 +15,8 @@
 # less the basal 1.2 W/kg; a missing states.sto, a missing model or a model whose user row is
 # not numbers exits 1 with one line naming the file. The prediction's lumbar_extension (-15 and
 # -17 deg) leaves the model's range of -15 ... +28.6 deg (radians in the file), not -20 ... +30
-# (degrees, the default when <compiler> gives no angle).
+# (degrees, the default when <compiler> gives no angle). Its knees flex 12 (right) and 9 deg (left)
+# in loading response (the fixture's comment); the track has no grf.mot, so no knee line.
 # usage: physiology_figures.sh GAITSIM SOURCE_DIR
 set -u
 src=$2
@@ -35,7 +36,18 @@ json.dump({"trial": "trial", "model": "m.xml", "stride_time_s": 1.0},
           open("results/track/summary.json", "w"))
 sto("results/sweep/predict_2/metabolics.sto", ["time", "ercspn_r", "vasint", "total"],
     [[0.25 * k, 300.0, 100.0, 400.0] for k in range(5)])
-sto("results/sweep/predict_2/states.sto", ["time", "lumbar_extension"], [[0, -15.0], [1, -17.0]])
+# lumbar_extension -15 / -17 (mean -16); the right foot on the ground at nodes 2-6, the left at
+# 9, 0, 1, 2 (its contact wraps round the stride's end): loading response = the contact node and
+# the next (20 % of 10 nodes), so the right knee's 12 deg and the left's 9 (nodes 9, 0), not the
+# 20 and 25 deg one node later
+knee_r = [0, 0, -5, -12, -20, -3, 0, 0, 0, 0]
+knee_l = [-9, -25, 0, 0, 0, 0, 0, 0, 0, -4]
+sto("results/sweep/predict_2/states.sto",
+    ["time", "lumbar_extension", "knee_flexion", "knee_flexion_l"],
+    [[0.1 * k, -15.0 if k % 2 == 0 else -17.0, knee_r[k], knee_l[k]] for k in range(10)])
+sto("results/sweep/predict_2/grf.mot", ["time", "ground_force_r_vy", "ground_force_l_vy"],
+    [[0.1 * k, 500.0 if 2 <= k <= 6 else 0.0, 500.0 if k in (9, 0, 1, 2) else 0.0]
+     for k in range(10)])
 sto("results/sweep/predict_2/muscle_forces.sto", ["time", "ercspn_r", "vasint"],
     [[0.25 * k, 500.0, 5.0] for k in range(5)])
 with open("m.xml", "w") as f:
@@ -61,6 +73,9 @@ check "slack: vasint 99.8 W above its 0.2 W floor" grep -qF \
   "  slack muscles (tendon force < 1 % Fmax), above the 1 W/kg floor: 99.8 W (0.979 W/kg); vasint 99.8, ercspn_r 0.0" <<<"$out"
 check "joint ranges: lumbar_extension -17 below -15 deg" grep -qxF \
   "  joint ranges (model): lumbar_extension -17.00 below -15.00" <<<"$out"
+check "loading-response knee flexion 12 / 9 deg" grep -qxF \
+  "  loading-response knee flexion (deg; the most flexed over the first 20 % of the stride after contact): right 12.0, left 9.0" <<<"$out"
+check "no grf.mot for the track: no knee line" test "$(grep -c "loading-response" <<<"$out")" -eq 1
 check "one prediction: no fit" test "$(grep -c "Ralston's form" <<<"$out")" -eq 0
 
 /usr/bin/python3 - <<'PY'

@@ -143,8 +143,7 @@ static int contact_params(const mjModel* m, int g, gsContactParams* prm, char* e
   return gs_contact_params_from_user(row, m->geom_size[3 * g], prm, err, errsz);
 }
 
-// force of sphere g on its body and where it acts; 0 if g is not a contact sphere
-static int sphere_force(const mjModel* m, const mjData* d, int g, gsContactOut* out) {
+int gs_physics_sphere_contact(const mjModel* m, const mjData* d, int g, gsContactOut* out) {
   if (!gs_geom_contact_side(m, g) || m->nuser_geom < GS_GEOM_NUSER) {
     return 0;
   }
@@ -168,10 +167,14 @@ static int sphere_force(const mjModel* m, const mjData* d, int g, gsContactOut* 
 }
 
 void gs_physics_contact_passive(const mjModel* m, mjData* d) {
+  gs_physics_foot_contact_passive(m, d, 0);
+}
+
+void gs_physics_foot_contact_passive(const mjModel* m, mjData* d, int side) {
   const mjtNum zero[3] = {0, 0, 0};
   for (int g = 0; g < m->ngeom; g++) {
     gsContactOut out;
-    if (!sphere_force(m, d, g, &out)) {
+    if ((side && gs_geom_contact_side(m, g) != side) || !gs_physics_sphere_contact(m, d, g, &out)) {
       continue;
     }
     mjtNum force[3] = {out.force[0], out.force[1], out.force[2]};
@@ -187,7 +190,7 @@ void gs_physics_foot_grf(const mjModel* m, const mjData* d, int side, double fn_
   int n = 0;
   for (int g = 0; g < m->ngeom && n < kMaxSpheres; g++) {
     gsContactOut out;
-    if (gs_geom_contact_side(m, g) != side || !sphere_force(m, d, g, &out)) {
+    if (gs_geom_contact_side(m, g) != side || !gs_physics_sphere_contact(m, d, g, &out)) {
       continue;
     }
     memcpy(forces + 3 * n, out.force, sizeof(out.force));

@@ -75,6 +75,14 @@ int gs_physics_step(const mjModel* m, mjData* d, mjtNum* fT_dot);
 // exposed for tests). Needs positions and velocities (mj_fwdPosition, mj_fwdVelocity's comVel).
 void gs_physics_contact_passive(const mjModel* m, mjData* d);
 
+// The same for one foot's spheres only (side 'r' or 'l'; 0: every sphere).
+void gs_physics_foot_contact_passive(const mjModel* m, mjData* d, int side);
+
+// Hunt-Crossley contact of geom g with the floor at the current state (gs_contact_sphere with the
+// sphere's centre velocity and its body's velocity at the contact point): force on the body, where
+// it acts, depth and its rate. Returns 1, or 0 (out untouched) when g is not a contact sphere.
+int gs_physics_sphere_contact(const mjModel* m, const mjData* d, int g, gsContactOut* out);
+
 // Ground reaction of one foot (side 'r' or 'l') from its contact spheres at the current state:
 // force, centre of pressure and free moment (gs_contact_foot_grf; COP defined above fn_min N).
 void gs_physics_foot_grf(const mjModel* m, const mjData* d, int side, double fn_min,

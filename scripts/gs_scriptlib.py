@@ -139,3 +139,24 @@ def inspect_muscles(gaitsim, model, pose_file, time, activation=None):
                      "F": float(f[5]), "Edot": float(f[6]),
                      "arms": {c: float(r) for c, r in (pair.split("=") for pair in f[7:])}}
     return out
+
+
+def mechanical_work(gaitsim, model, pose_file):
+    """{source: (positive, negative, net) J} and the distance the centre of mass travelled (m),
+    from `GAITSIM work MODEL --pose POSE_FILE` (app/cmd_work.c: a markdown table of the sources,
+    then the energy balance and the distance). PrepError naming gaitsim when it fails."""
+    res = subprocess.run([gaitsim, "work", model, "--pose", pose_file], capture_output=True,
+                         text=True)
+    if res.returncode != 0:
+        raise PrepError(gaitsim, f"work failed: {res.stderr.strip()}")
+    rows, distance = {}, None
+    for line in res.stdout.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if line.startswith("|") and len(cells) == 5 and cells[0] not in ("source", "---"):
+            rows[cells[0]] = tuple(float(c) for c in cells[1:4])
+        elif line.startswith("centre of mass travelled"):
+            distance = float(line.split()[4])
+    if not rows or distance is None:
+        raise PrepError(gaitsim, "work printed no table")
+    return rows, distance
+

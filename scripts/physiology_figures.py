@@ -27,7 +27,10 @@ trunk muscles (ercspn, intobl, extobl) carry about each lumbar coordinate at 20 
 stride (`GAITSIM inspect MODEL --pose DIR/states.sto --time t`, MODEL from summary.json): their
 summed power (W) and the mean over the instants of the net moment |sum F r| and of the summed
 muscle moments sum |F r| (N m); the ratio of the two is the co-contraction the lumbar moments
-cost.
+cost; and the stride's mechanical work by source (`GAITSIM work MODEL --pose DIR/states.sto`):
+the contractile elements' positive and negative work per metre, the foot contact's dissipation
+and rebound per collision against Zelik & Kuo 2010's soft-tissue work, and the contractile
+positive work over the muscles' metabolic energy (metabolics.sto).
 Muscle groups by name: trunk (ercspn, intobl, extobl), vasti, soleus, gastrocnemii, rectus
 femoris, hamstrings, gluteals, iliopsoas, adductors, tibialis anterior, other. Exit 1 with one
 line naming the file when an input is missing.
@@ -40,7 +43,8 @@ import sys
 import xml.etree.ElementTree as ET
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gs_scriptlib import PrepError, inspect_muscles, read_json, read_storage  # noqa: E402
+from gs_scriptlib import (PrepError, inspect_muscles, mechanical_work, read_json,  # noqa: E402
+                          read_storage)
 from validation import BASAL_W_PER_KG, fit_ralston_form, ralston_gross_w_per_kg  # noqa: E402
 
 COORDINATES = ["pelvis_tz", "pelvis_rx", "hip_adduction", "hip_adduction_l", "knee_adduction",
@@ -294,6 +298,44 @@ def trunk_moments(gaitsim, folder):
         print(f"  {c:18s} {net[c]:7.1f} {summed[c]:7.1f}")
 
 
+# Zelik & Kuo 2010, J Exp Biol 213:4257, at 1.25 m/s: the soft tissues' negative work per
+# collision and their rebound after it (J), from joint work against centre-of-mass work
+SOFT_TISSUE_COLLISION_J, SOFT_TISSUE_REBOUND_J = 7.5, 4.0
+
+
+def work_budget(gaitsim, folder):
+    """The stride's mechanical work by source (`GAITSIM work`, mechanical_work): the contractile
+    elements' positive and negative work per metre (J/(kg m)), the foot contact's negative and
+    positive work per collision (half the stride's: two heel strikes; J), split into its normal
+    forces (whose net is the Hunt-Crossley damping's loss) and friction, and the contractile
+    positive work over the muscles' metabolic energy (metabolics.sto, when present)."""
+    s = read_json(os.path.join(folder, "summary.json"))
+    model = s.get("model")
+    mass = s["body_weight_n"] / 9.81 if s.get("body_weight_n") else None
+    if not model or not mass:
+        raise PrepError(os.path.join(folder, "summary.json"), "no model or body_weight_n")
+    try:
+        rows, distance = mechanical_work(gaitsim, model, os.path.join(folder, "states.sto"))
+    except PrepError as e:
+        raise PrepError(folder, f"gaitsim {e.reason}")
+    ce = rows["their contractile elements (active fibre force)"]
+    foot = rows["foot contact spheres"]
+    normal = rows["their normal forces (elastic and Hunt-Crossley damping)"]
+    friction = rows["their friction"]
+    line = (f"{folder}: mechanical work over {distance:.3f} m: contractile elements "
+            f"+{ce[0] / mass / distance:.3f} / {ce[1] / mass / distance:.3f} J/(kg m); foot "
+            f"contact per collision (half the stride's) {foot[1] / 2:.1f} / +{foot[0] / 2:.1f} "
+            f"J, its normal forces {normal[1] / 2:.1f} / +{normal[0] / 2:.1f} J (net "
+            f"{normal[2] / 2:.1f}: damping), friction {friction[2] / 2:.1f} J (Zelik & Kuo 2010 "
+            f"at 1.25 m/s, soft tissue: -{SOFT_TISSUE_COLLISION_J} / +{SOFT_TISSUE_REBOUND_J} J)")
+    met_path = os.path.join(folder, "metabolics.sto")
+    if os.path.exists(met_path):
+        met = columns(met_path)
+        energy = mean_over_time(met["time"], met["total"]) * (met["time"][-1] - met["time"][0])
+        line += f"; contractile positive work / muscles' metabolic energy {ce[0] / energy:.3f}"
+    print(line)
+
+
 def main(argv):
     args = argv[1:]
     gaitsim = None
@@ -317,6 +359,8 @@ def main(argv):
         if gaitsim:
             for folder in [os.path.join(results, "track")] + predictions:
                 trunk_moments(gaitsim, folder)
+            for folder in [os.path.join(results, "track")] + predictions:
+                work_budget(gaitsim, folder)
     except PrepError as e:
         print(f"physiology_figures: {e}", file=sys.stderr)
         return 1

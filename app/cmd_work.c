@@ -1,0 +1,181 @@
+// cmd_work.c: `gaitsim work MODEL --pose FILE`: the mechanical work over the rows of a gait's
+// states (callbacks/gs_work.h): each source's positive, negative and net work by the trapezoidal
+// rule over the rows, and the energy balance that checks it.
+#include <getopt.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <mujoco/mujoco.h>
+
+#include "app/gs_app_model.h"
+#include "app/gs_commands.h"
+#include "app/gs_options.h"
+#include "callbacks/gs_coupling.h"
+#include "callbacks/gs_model_info.h"
+#include "callbacks/gs_state.h"
+#include "callbacks/gs_work.h"
+
+static const char* kWorkUsage =
+    "usage: gaitsim work MODEL --pose FILE\n\n"
+    "The mechanical work of a gait over the rows of FILE (a solution's or a simulation's\n"
+    "states.sto: coordinates, speeds, activations and tendon forces; a solution's rows span one\n"
+    "stride), by the trapezoidal rule: for each source, the positive, negative and net work (J)\n"
+    "and its net mean power per kg of body mass (W/kg). Sources: the muscle-tendon units and\n"
+    "their contractile elements (active fibre force; the work Umberger 2010 prices), passive\n"
+    "fibre force, tendons, the foot contact spheres (net negative: the energy the contact\n"
+    "dissipates; its negative work is the stand-in for the soft tissues' collision work) with\n"
+    "their normal forces (elastic and Hunt-Crossley damping) and their friction, the\n"
+    "implant knee's contact and ligaments, joint-limit moments, couplings, MuJoCo's passive and\n"
+    "constraint forces (callbacks/gs_work.h). The last lines check the budget: the sum of the\n"
+    "net works against the change of kinetic plus potential energy from the first row to the\n"
+    "last (equal up to the rows' time discretisation), and the distance the pelvis travelled.\n";
+
+// the file must carry every speed and every muscle state: the work needs the velocities and
+// the muscle forces, which an absent column would silently zero
+static int require_states(const mjModel* m, const gsTable* t, const gsStateMap* map,
+                          const char* path) {
+  for (int j = 0; j < m->njnt; j++) {
+    int dof = m->jnt_dofadr[j];
+    if (m->jnt_type[j] != mjJNT_HINGE && m->jnt_type[j] != mjJNT_SLIDE) continue;
+    if (map->qvel_col[dof] >= 0 || gs_coupling_joint_follows(m, j)) continue;
+    fprintf(stderr, "gaitsim: %s: no speed column %s_u (the work needs every speed)\n", path,
+            mj_id2name(m, mjOBJ_JOINT, j));
+    return -1;
+  }
+  for (int i = 0; i < m->nu; i++) {
+    if (!gs_actuator_is_gaitsim_muscle(m, i)) continue;
+    const char* name = mj_id2name(m, mjOBJ_ACTUATOR, i);
+    int act = i - (m->nu - m->na);  // MuJoCo 2.2: the stateful actuators come last
+    if (act >= 0 && map->act_col[act] < 0) {
+      fprintf(stderr, "gaitsim: %s: no column %s.activation (the work needs every muscle's "
+              "state)\n", path, name);
+      return -1;
+    }
+    if (gs_actuator_has_elastic_tendon(m, i) && map->fT_col[i] < 0) {
+      fprintf(stderr, "gaitsim: %s: no column %s.normalized_tendon_force (the work needs "
+              "every muscle's state)\n", path, name);
+      return -1;
+    }
+  }
+  (void)t;
+  return 0;
+}
+
+enum { kMtu, kCe, kFibre, kTendon, kFoot, kFootNormal, kFriction, kKnee, kLimits, kCouplings,
+       kMujoco, kOther, kConstraint, kApplied, kSources };
+
+static const char* const kSourceName[kSources] = {
+    "muscle-tendon units", "  their contractile elements (active fibre force)",
+    "  their passive fibre force and damping", "  their tendons", "foot contact spheres",
+    "  their normal forces (elastic and Hunt-Crossley damping)", "  their friction",
+    "implant knee: contact and ligaments", "joint-limit moments", "coordinate couplings",
+    "MuJoCo passive forces (joint damping, springs)", "other actuators",
+    "MuJoCo constraint forces", "applied forces"};
+
+// positive and negative power of each source at one row (W)
+static void row_powers(const gsPowers* p, double pos[kSources], double neg[kSources]) {
+  double net[kSources] = {0};
+  memset(pos, 0, sizeof(double) * kSources);
+  memset(neg, 0, sizeof(double) * kSources);
+  pos[kMtu] = p->mtu_pos, neg[kMtu] = p->mtu_neg;
+  pos[kCe] = p->ce_pos, neg[kCe] = p->ce_neg;
+  pos[kFoot] = p->foot_pos, neg[kFoot] = p->foot_neg;
+  pos[kFootNormal] = p->foot_normal_pos, neg[kFootNormal] = p->foot_normal_neg;
+  net[kFriction] = p->foot_friction;
+  net[kFibre] = p->fibre_passive, net[kTendon] = p->tendon, net[kKnee] = p->knee;
+  net[kLimits] = p->joint_limits, net[kCouplings] = p->couplings;
+  net[kMujoco] = p->mujoco_passive, net[kOther] = p->other_actuators;
+  net[kConstraint] = p->constraint, net[kApplied] = p->applied;
+  for (int k = 0; k < kSources; k++) {
+    if (net[k] > 0) pos[k] += net[k];
+    else neg[k] += net[k];
+  }
+}
+
+int gs_cmd_work(int argc, char** argv) {
+  static const struct option options[] = {{"pose", required_argument, NULL, 'p'},
+                                          {"help", no_argument, NULL, 'h'},
+                                          {NULL, 0, NULL, 0}};
+  const char* pose = NULL;
+  optind = 1;
+  opterr = 0;
+  int c;
+  while ((c = getopt_long(argc, argv, ":p:h", options, NULL)) != -1) {
+    switch (c) {
+      case 'p': pose = optarg; break;
+      case 'h': fputs(kWorkUsage, stdout); return GS_EXIT_OK;
+      default: return gs_opt_getopt_error("work", c, argv);
+    }
+  }
+  if (gs_opt_one_operand("work", "MODEL", argc, argv) != 0) return GS_EXIT_USAGE;
+  if (!pose) return gs_opt_usage_error("work", "missing --pose FILE");
+  const char* path = argv[optind];
+  mjModel* m = gs_app_load_model(path);
+  if (!m) return GS_EXIT_FAILURE;
+  int status = GS_EXIT_FAILURE;
+  mjData* d = mj_makeData(m);
+  gsTable t;
+  gs_table_init(&t);
+  gsStateMap map = {0};
+  char err[512];
+  if (gs_app_read_table(m, pose, &t) != 0 || gs_app_require_coordinates(m, &t, pose) != 0)
+    goto done;
+  if (gs_state_map(m, &t, &map, err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s: %s\n", pose, err);
+    goto done;
+  }
+  if (require_states(m, &t, &map, pose) != 0) goto done;
+  if (t.nrow < 2) {
+    fprintf(stderr, "gaitsim: %s: %d row; the work needs at least 2\n", pose, t.nrow);
+    goto done;
+  }
+  double pos[kSources] = {0}, neg[kSources] = {0};
+  double prev_pos[kSources] = {0}, prev_neg[kSources] = {0};
+  double e_first = 0, e_last = 0, x_first = 0, x_last = 0;
+  int n = t.nrow;
+  for (int i = 0; i < n; i++) {
+    mj_resetData(m, d);
+    gs_state_apply(m, &t, &map, t.time[i], d);
+    mj_forward(m, d);
+    gsPowers p;
+    gs_work_powers(m, d, &p);
+    double rp[kSources], rn[kSources];
+    row_powers(&p, rp, rn);
+    if (i > 0) {
+      double h = t.time[i] - t.time[i - 1];
+      for (int k = 0; k < kSources; k++) {
+        pos[k] += 0.5 * h * (rp[k] + prev_pos[k]);
+        neg[k] += 0.5 * h * (rn[k] + prev_neg[k]);
+      }
+    }
+    memcpy(prev_pos, rp, sizeof(rp));
+    memcpy(prev_neg, rn, sizeof(rn));
+    double e = p.kinetic + p.potential;
+    if (i == 0) e_first = e, x_first = d->subtree_com[0];
+    e_last = e, x_last = d->subtree_com[0];
+  }
+  double mass = m->body_subtreemass[0], span = t.time[n - 1] - t.time[0];
+  printf("mechanical work of %s over %s (%d rows, %.4f-%.4f s, %.4f s; body mass %.2f kg)\n",
+         path, pose, n, t.time[0], t.time[n - 1], span, mass);
+  printf("| source | positive (J) | negative (J) | net (J) | net mean power (W/kg) |\n");
+  printf("|---|---|---|---|---|\n");
+  double sum = 0;
+  for (int k = 0; k < kSources; k++) {
+    double net = pos[k] + neg[k];
+    printf("| %s | %.2f | %.2f | %.2f | %.4f |\n", kSourceName[k], pos[k], neg[k], net,
+           span > 0 ? net / span / mass : 0.0);
+    if (kSourceName[k][0] != ' ') sum += net;  // the indented parts are in the row above
+  }
+  printf("sum of the net works: %.2f J; change of kinetic plus potential energy: %.2f J "
+         "(difference %.2f J)\n", sum, e_last - e_first, sum - (e_last - e_first));
+  printf("centre of mass travelled %.4f m forward (x)\n", x_last - x_first);
+  status = GS_EXIT_OK;
+done:
+  gs_state_map_free(&map);
+  gs_table_free(&t);
+  mj_deleteData(d);
+  mj_deleteModel(m);
+  return status;
+}

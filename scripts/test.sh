@@ -34,7 +34,7 @@ cmake --build build-asan -j"$jobs"
 echo "== command-line tests under AddressSanitizer and UndefinedBehaviorSanitizer (a subset)"
 (cd build-asan && LSAN_OPTIONS=suppressions="$PWD/../tests/lsan.supp" ASAN_OPTIONS=detect_leaks=1 \
   ctest --output-on-failure -j"$jobs" \
-  -R '^cli_(bad_inputs|model_errors|simulate_inspect|hold_drop|render|predict_goals)$')
+  -R '^cli_(bad_inputs|model_errors|simulate_inspect|hold_drop|render|predict_goals|work)$')
 
 echo "== fuzz targets (clang, libFuzzer, bounded time)"
 CC=clang cmake -S . -B build-fuzz -DCMAKE_BUILD_TYPE=Debug -DGAITSIM_FUZZ=ON >/dev/null

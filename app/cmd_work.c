@@ -14,11 +14,14 @@
 #include "app/gs_options.h"
 #include "callbacks/gs_coupling.h"
 #include "callbacks/gs_model_info.h"
+#include "callbacks/gs_physics.h"
 #include "callbacks/gs_state.h"
 #include "callbacks/gs_work.h"
 
+#define WORK_STANCE_N 20.0  // a foot is in stance above this vertical force (N)
+
 static const char* kWorkUsage =
-    "usage: gaitsim work MODEL --pose FILE\n\n"
+    "usage: gaitsim work MODEL --pose FILE [--joints]\n\n"
     "The mechanical work of a gait over the rows of FILE (a solution's or a simulation's\n"
     "states.sto: coordinates, speeds, activations and tendon forces; a solution's rows span one\n"
     "stride), by the trapezoidal rule: for each source, the positive, negative and net work (J)\n"
@@ -30,7 +33,12 @@ static const char* kWorkUsage =
     "implant knee's contact and ligaments, joint-limit moments, couplings, MuJoCo's passive and\n"
     "constraint forces (callbacks/gs_work.h). The last lines check the budget: the sum of the\n"
     "net works against the change of kinetic plus potential energy from the first row to the\n"
-    "last (equal up to the rows' time discretisation), and the distance the pelvis travelled.\n";
+    "last (equal up to the rows' time discretisation), and the distance the centre of mass\n"
+    "travelled.\n\n"
+    "  --joints  also the muscles' work at each coordinate (their net moment about it times its\n"
+    "            speed: the joint work of inverse dynamics less the passive structures'),\n"
+    "            positive and negative over all rows and over the rows where the foot below\n"
+    "            the coordinate is in stance (its vertical ground force above 20 N)\n";
 
 // the file must carry every speed and every muscle state: the work needs the velocities and
 // the muscle forces, which an absent column would silently zero
@@ -96,15 +104,18 @@ static void row_powers(const gsPowers* p, double pos[kSources], double neg[kSour
 
 int gs_cmd_work(int argc, char** argv) {
   static const struct option options[] = {{"pose", required_argument, NULL, 'p'},
+                                          {"joints", no_argument, NULL, 'j'},
                                           {"help", no_argument, NULL, 'h'},
                                           {NULL, 0, NULL, 0}};
   const char* pose = NULL;
+  int joints = 0;
   optind = 1;
   opterr = 0;
   int c;
-  while ((c = getopt_long(argc, argv, ":p:h", options, NULL)) != -1) {
+  while ((c = getopt_long(argc, argv, ":p:jh", options, NULL)) != -1) {
     switch (c) {
       case 'p': pose = optarg; break;
+      case 'j': joints = 1; break;
       case 'h': fputs(kWorkUsage, stdout); return GS_EXIT_OK;
       default: return gs_opt_getopt_error("work", c, argv);
     }
@@ -134,7 +145,15 @@ int gs_cmd_work(int argc, char** argv) {
   double pos[kSources] = {0}, neg[kSources] = {0};
   double prev_pos[kSources] = {0}, prev_neg[kSources] = {0};
   double e_first = 0, e_last = 0, x_first = 0, x_last = 0;
-  int n = t.nrow;
+  int n = t.nrow, nv = m->nv;
+  // per dof: work positive, negative, and in stance positive, negative (J); this row's powers
+  double* dof = (double*)calloc((size_t)(6 * nv), sizeof(double));
+  if (!dof) {
+    fprintf(stderr, "gaitsim: work: out of memory\n");
+    goto done;
+  }
+  double *dof_now = dof + 4 * nv, *dof_prev = dof + 5 * nv;
+  int stance_prev[2] = {0, 0};
   for (int i = 0; i < n; i++) {
     mj_resetData(m, d);
     gs_state_apply(m, &t, &map, t.time[i], d);
@@ -152,6 +171,27 @@ int gs_cmd_work(int argc, char** argv) {
     }
     memcpy(prev_pos, rp, sizeof(rp));
     memcpy(prev_neg, rn, sizeof(rn));
+    gs_work_dof_muscle_powers(m, d, dof_now);
+    int stance[2];
+    for (int f = 0; f < 2; f++) {
+      gsFootGrf grf;
+      gs_physics_foot_grf(m, d, f == 0 ? 'r' : 'l', WORK_STANCE_N, &grf);
+      stance[f] = grf.loaded;
+    }
+    for (int k = 0; i > 0 && k < nv; k++) {
+      // the trapezoid's two ends, each counted positive or negative by its own sign
+      double h = 0.5 * (t.time[i] - t.time[i - 1]);
+      int side = gs_work_dof_side(m, k), f = side == 'r' ? 0 : side == 'l' ? 1 : -1;
+      const double ends[2] = {dof_prev[k], dof_now[k]};
+      const int on[2] = {f >= 0 && stance_prev[f], f >= 0 && stance[f]};
+      for (int e = 0; e < 2; e++) {
+        int sign = ends[e] < 0;  // 0: positive, 1: negative
+        dof[sign * nv + k] += h * ends[e];
+        if (on[e]) dof[(2 + sign) * nv + k] += h * ends[e];
+      }
+    }
+    memcpy(dof_prev, dof_now, sizeof(double) * (size_t)nv);
+    memcpy(stance_prev, stance, sizeof(stance));
     double e = p.kinetic + p.potential;
     if (i == 0) e_first = e, x_first = d->subtree_com[0];
     e_last = e, x_last = d->subtree_com[0];
@@ -171,6 +211,19 @@ int gs_cmd_work(int argc, char** argv) {
   printf("sum of the net works: %.2f J; change of kinetic plus potential energy: %.2f J "
          "(difference %.2f J)\n", sum, e_last - e_first, sum - (e_last - e_first));
   printf("centre of mass travelled %.4f m forward (x)\n", x_last - x_first);
+  if (joints) {
+    printf("\nthe muscles' work at each coordinate (J; stance: its foot's vertical force above "
+           "%.0f N)\n", WORK_STANCE_N);
+    printf("| coordinate | positive | negative | in stance: positive | negative |\n");
+    printf("|---|---|---|---|---|\n");
+    for (int k = 0; k < nv; k++) {
+      if (dof[k] < 0.005 && dof[nv + k] > -0.005) continue;  // below the printed 0.01 J
+      const char* name = mj_id2name(m, mjOBJ_JOINT, m->dof_jntid[k]);
+      printf("| %s | %.2f | %.2f | %.2f | %.2f |\n", name ? name : "(unnamed)", dof[k],
+             dof[nv + k], dof[2 * nv + k], dof[3 * nv + k]);
+    }
+  }
+  free(dof);
   status = GS_EXIT_OK;
 done:
   gs_state_map_free(&map);

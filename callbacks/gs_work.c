@@ -106,3 +106,31 @@ double gs_work_total(const gsPowers* p) {
   return p->mtu_pos + p->mtu_neg + p->foot_pos + p->foot_neg + p->knee + p->joint_limits +
          p->couplings + p->mujoco_passive + p->other_actuators + p->constraint + p->applied;
 }
+
+void gs_work_dof_muscle_powers(const mjModel* m, const mjData* d, double* power) {
+  // each muscle's generalised force is its moment-arm row times its force (actuator_moment)
+  for (int k = 0; k < m->nv; k++) power[k] = 0;
+  for (int i = 0; i < m->nu; i++) {
+    if (!gs_actuator_is_gaitsim_muscle(m, i)) continue;
+    for (int k = 0; k < m->nv; k++)
+      power[k] += d->actuator_moment[i * m->nv + k] * d->actuator_force[i] * d->qvel[k];
+  }
+}
+
+// 1 when body b is body a or hangs below it
+static int below(const mjModel* m, int b, int a) {
+  for (; b > 0; b = m->body_parentid[b])
+    if (b == a) return 1;
+  return a == 0;
+}
+
+int gs_work_dof_side(const mjModel* m, int k) {
+  int body = m->dof_bodyid[k], side = 0;
+  for (int g = 0; g < m->ngeom; g++) {
+    int s = gs_geom_contact_side(m, g);
+    if (!s || !below(m, m->geom_bodyid[g], body)) continue;
+    if (side && side != s) return 0;
+    side = s;
+  }
+  return side;
+}

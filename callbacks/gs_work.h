@@ -67,4 +67,14 @@ void gs_work_powers(const mjModel* m, mjData* d, gsPowers* p);
 // The sum of the non-gravity powers: d/dt (KE + PE) (W).
 double gs_work_total(const gsPowers* p);
 
+// The muscles' power at each degree of freedom (W, nv entries): qfrc_actuator[k] qdot[k] of the
+// gaitsim muscles alone, i.e. their net moment about coordinate k times its speed; the joint
+// power of inverse dynamics less the passive structures' part. Their sum over k is
+// mtu_pos + mtu_neg. Needs mj_forward; d->qfrc_actuator is not changed.
+void gs_work_dof_muscle_powers(const mjModel* m, const mjData* d, double* power);
+
+// The foot whose contact spheres hang below degree of freedom k: 'r', 'l', or 0 when both feet
+// or none do (the pelvis's dofs, the trunk's, the arms').
+int gs_work_dof_side(const mjModel* m, int k);
+
 #endif  // GAITSIM_CALLBACKS_GS_WORK_H_

@@ -142,21 +142,27 @@ def inspect_muscles(gaitsim, model, pose_file, time, activation=None):
 
 
 def mechanical_work(gaitsim, model, pose_file):
-    """{source: (positive, negative, net) J} and the distance the centre of mass travelled (m),
-    from `GAITSIM work MODEL --pose POSE_FILE` (app/cmd_work.c: a markdown table of the sources,
-    then the energy balance and the distance). PrepError naming gaitsim when it fails."""
-    res = subprocess.run([gaitsim, "work", model, "--pose", pose_file], capture_output=True,
-                         text=True)
+    """({source: (positive, negative, net) J}, distance the centre of mass travelled (m),
+    {coordinate: (positive, negative, positive in stance, negative in stance) J}) from `GAITSIM
+    work MODEL --pose POSE_FILE --joints` (app/cmd_work.c: a markdown table of the sources, the
+    energy balance and the distance, then the muscles' work per coordinate). PrepError naming
+    gaitsim when it fails."""
+    res = subprocess.run([gaitsim, "work", model, "--pose", pose_file, "--joints"],
+                         capture_output=True, text=True)
     if res.returncode != 0:
         raise PrepError(gaitsim, f"work failed: {res.stderr.strip()}")
-    rows, distance = {}, None
+    rows, joints, distance = {}, {}, None
     for line in res.stdout.splitlines():
         cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if line.startswith("|") and len(cells) == 5 and cells[0] not in ("source", "---"):
+        header = cells[0] in ("source", "coordinate") or cells[0][:3] == "---"
+        if not line.startswith("|") or header:
+            if line.startswith("centre of mass travelled"):
+                distance = float(line.split()[4])
+            continue
+        if len(cells) == 5 and distance is None:
             rows[cells[0]] = tuple(float(c) for c in cells[1:4])
-        elif line.startswith("centre of mass travelled"):
-            distance = float(line.split()[4])
+        elif len(cells) == 5:
+            joints[cells[0]] = tuple(float(c) for c in cells[1:5])
     if not rows or distance is None:
         raise PrepError(gaitsim, "work printed no table")
-    return rows, distance
-
+    return rows, distance, joints

@@ -29,8 +29,10 @@ summed power (W) and the mean over the instants of the net moment |sum F r| and 
 muscle moments sum |F r| (N m); the ratio of the two is the co-contraction the lumbar moments
 cost; and the stride's mechanical work by source (`GAITSIM work MODEL --pose DIR/states.sto`):
 the contractile elements' positive and negative work per metre, the foot contact's dissipation
-and rebound per collision against Zelik & Kuo 2010's soft-tissue work, and the contractile
-positive work over the muscles' metabolic energy (metabolics.sto).
+and rebound per collision against Zelik & Kuo 2010's soft-tissue work, the contractile
+positive work over the muscles' metabolic energy (metabolics.sto), and per leg the muscles'
+work at hip_flexion, knee_flexion and ankle_angle in stance (`--joints`) with the knee's share
+of the negative and the ankle's of the positive against Montgomery & Grabowski 2018's.
 Muscle groups by name: trunk (ercspn, intobl, extobl), vasti, soleus, gastrocnemii, rectus
 femoris, hamstrings, gluteals, iliopsoas, adductors, tibialis anterior, other. Exit 1 with one
 line naming the file when an input is missing.
@@ -301,6 +303,11 @@ def trunk_moments(gaitsim, folder):
 # Zelik & Kuo 2010, J Exp Biol 213:4257, at 1.25 m/s: the soft tissues' negative work per
 # collision and their rebound after it (J), from joint work against centre-of-mass work
 SOFT_TISSUE_COLLISION_J, SOFT_TISSUE_REBOUND_J = 7.5, 4.0
+# Montgomery & Grabowski 2018, R Soc Open Sci 5:180550 (twenty adults, 1.00-1.50 m/s, stance,
+# sagittal joint work): the knee's share of the leg's negative work (0.39 at 1.00 m/s, 0.45 at
+# 1.50 m/s, over their slopes) and the ankle's of the positive (0.42 at every speed and slope)
+KNEE_NEGATIVE_SHARE, ANKLE_POSITIVE_SHARE = "0.39-0.45", "0.42"
+SAGITTAL = ("hip_flexion", "knee_flexion", "ankle_angle")
 
 
 def work_budget(gaitsim, folder):
@@ -308,14 +315,16 @@ def work_budget(gaitsim, folder):
     elements' positive and negative work per metre (J/(kg m)), the foot contact's negative and
     positive work per collision (half the stride's: two heel strikes; J), split into its normal
     forces (whose net is the Hunt-Crossley damping's loss) and friction, and the contractile
-    positive work over the muscles' metabolic energy (metabolics.sto, when present)."""
+    positive work over the muscles' metabolic energy (metabolics.sto, when present); per leg, the
+    muscles' stance work at the SAGITTAL coordinates and the knee's and ankle's shares."""
     s = read_json(os.path.join(folder, "summary.json"))
     model = s.get("model")
     mass = s["body_weight_n"] / 9.81 if s.get("body_weight_n") else None
     if not model or not mass:
         raise PrepError(os.path.join(folder, "summary.json"), "no model or body_weight_n")
     try:
-        rows, distance = mechanical_work(gaitsim, model, os.path.join(folder, "states.sto"))
+        rows, distance, joints = mechanical_work(gaitsim, model,
+                                                 os.path.join(folder, "states.sto"))
     except PrepError as e:
         raise PrepError(folder, f"gaitsim {e.reason}")
     ce = rows["their contractile elements (active fibre force)"]
@@ -334,6 +343,17 @@ def work_budget(gaitsim, folder):
         energy = mean_over_time(met["time"], met["total"]) * (met["time"][-1] - met["time"][0])
         line += f"; contractile positive work / muscles' metabolic energy {ce[0] / energy:.3f}"
     print(line)
+    for side, suffix in (("right", ""), ("left", "_l")):
+        work = [joints.get(c + suffix) for c in SAGITTAL]
+        if None in work:
+            continue
+        neg, pos = [w[3] for w in work], [w[2] for w in work]
+        print(f"  {side} leg in stance, the muscles' work at hip / knee / ankle (J): negative "
+              + " / ".join(f"{x:.1f}" for x in neg) + ", positive "
+              + " / ".join(f"{x:.1f}" for x in pos)
+              + f"; the knee's share of the negative {neg[1] / sum(neg):.2f}, the ankle's of the "
+              f"positive {pos[2] / sum(pos):.2f} (Montgomery & Grabowski 2018: "
+              f"{KNEE_NEGATIVE_SHARE} and {ANKLE_POSITIVE_SHARE})")
 
 
 def main(argv):

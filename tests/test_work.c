@@ -4,7 +4,9 @@
 // (a) at one state the pieces add up: the muscle-tendon units' power equals qfrc_actuator . qdot
 //     (1e-9 relative), the passive pieces qfrc_passive . qdot (1e-9), each unit's contractile,
 //     passive-fibre and tendon parts its whole (by construction of the tendon part: checked that
-//     the tendon's power is -F_T vT of the tendon alone, 1e-6 of the unit's power scale);
+//     the tendon's power is -F_T vT of the tendon alone, 1e-6 of the unit's power scale); the
+//     muscles' power by coordinate sums to the units' (1e-9), and the coordinates of each leg
+//     belong to its foot, the pelvis's and the trunk's to neither;
 // (b) the energy theorem at one state (the body lowered 1 cm into the floor, every dof moving,
 //     every muscle at activation 0.2): d/dt (KE + PE) by central differences along the state's
 //     own motion equals the budget's total within 1e-6 of the sum of the sources' magnitudes,
@@ -61,6 +63,21 @@ int main(void) {
     scale += fabs(f * d->actuator_velocity[i]);
   }
   EXPECT_NEAR(tendon, p.tendon, 1e-6 * scale);
+  // the muscles' power by coordinate adds up to the units' power, and each coordinate belongs
+  // to the foot below it
+  double* dof = (double*)calloc((size_t)m->nv, sizeof(double));
+  gs_work_dof_muscle_powers(m, d, dof);
+  double dof_sum = 0;
+  for (int k = 0; k < m->nv; k++) dof_sum += dof[k];
+  EXPECT_NEAR(p.mtu_pos + p.mtu_neg, dof_sum, 1e-9 * scale);
+  free(dof);
+  const char* sides[][2] = {{"knee_flexion", "r"}, {"ankle_angle_l", "l"}, {"pelvis_tx", ""},
+                            {"lumbar_bending", ""}, {"hip_flexion", "r"}};
+  for (int k = 0; k < 5; k++) {
+    int j = mj_name2id(m, mjOBJ_JOINT, sides[k][0]);
+    EXPECT_TRUE(j >= 0);
+    if (j >= 0) EXPECT_EQ_INT(sides[k][1][0], gs_work_dof_side(m, m->jnt_dofadr[j]));
+  }
 
   // (b) the energy theorem at one state: d/dt (KE + PE) by central differences along the
   // state's own motion (q +- eps qdot, qdot +- eps qdd, with qdd from mj_forward) against the

@@ -13,7 +13,9 @@
 # feet -30 / +4 J, their normal forces -26 / +10 J, friction -4 J) gives per metre +1.000 /
 # -0.500 J/(kg m), per collision -15.0 / +2.0, -13.0 / +5.0 (net -8.0) and -2.0 J, and over the
 # prediction's 400 J of metabolic energy a ratio of 0.510 (none for the track, without
-# metabolics.sto); with two more predictions at 1.0 and 1.5 m/s (erector spinae 300 W, vasti
+# metabolics.sto); its `--joints` rows (hip / knee / ankle in stance: -1.0 / -1.5 / -2.5 and
+# +1.5 / +2.0 / +5.0 J) give the right leg's knee share of the negative 0.30 and the ankle's of
+# the positive 0.59, and no left-leg line; with two more predictions at 1.0 and 1.5 m/s (erector spinae 300 W, vasti
 # 25 v^2 W) the fit a + b v^2 gives the trunk a = 2.943, b = 0 W/kg (a / v 2.943 .. 1.471 J/(kg m)), the
 # vasti a = 0, b = 0.245, the muscles a = 2.943, b = 0.245, beside Ralston's 0.822 + 1.331 v^2
 # less the basal 1.2 W/kg; a missing states.sto, a missing model or a model whose user row is
@@ -116,6 +118,13 @@ if [ "$1" = work ]; then
   echo "|   their friction | 0.00 | -4.00 | -4.00 | -0.0400 |"
   echo "sum of the net works: 0.00 J; change of kinetic plus potential energy: 0.00 J (difference 0.00 J)"
   echo "centre of mass travelled 2.0000 m forward (x)"
+  echo
+  echo "the muscles' work at each coordinate (J; stance: its foot's vertical force above 20 N)"
+  echo "| coordinate | positive | negative | in stance: positive | negative |"
+  echo "|---|---|---|---|---|"
+  echo "| hip_flexion | 2.00 | -1.00 | 1.50 | -1.00 |"
+  echo "| knee_flexion | 3.00 | -2.00 | 2.00 | -1.50 |"
+  echo "| ankle_angle | 6.00 | -3.00 | 5.00 | -2.50 |"
   exit 0
 fi
 [ "$1" = inspect ] || exit 2
@@ -140,6 +149,12 @@ check "--gaitsim: the track's work, no metabolics.sto" grep -qxF "results/track:
 check "--gaitsim: the prediction's work, 203.88 J of 400 J" grep -qxF \
   "results/sweep/predict_2: $work; contractile positive work / muscles' metabolic energy 0.510" \
   <<<"$out"
+joints="  right leg in stance, the muscles' work at hip / knee / ankle (J): negative -1.0 / -1.5 /"
+joints+=" -2.5, positive 1.5 / 2.0 / 5.0; the knee's share of the negative 0.30, the ankle's of the"
+joints+=" positive 0.59 (Montgomery & Grabowski 2018: 0.39-0.45 and 0.42)"
+check "--gaitsim: the right leg's joint work and shares, twice" \
+  test "$(grep -cxF "$joints" <<<"$out")" -eq 2
+check "--gaitsim: no left leg line (no left coordinates)" test "$(grep -c "left leg in stance" <<<"$out")" -eq 0
 
 cp m.xml m.good
 sed -i 's/<compiler angle="radian"\/>//; s/range="-0.2617993877991494 0.5"/range="-20 30"/' m.xml

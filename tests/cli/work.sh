@@ -5,9 +5,10 @@
 # of kinetic plus potential energy within 2 % (the rows' trapezoidal rule against the
 # simulation's semi-implicit Euler steps; measured: equal to the printed 0.01 J), the unit's net
 # work is over 1 J in size, and its contractile, passive-fibre and tendon parts add up to it
-# (0.02 J, the printed rounding). Bad input: a pose file without speeds (the trial's
-# coordinates.mot) and a missing file exit 1 with one line naming the file (and the missing
-# column); no --pose exits 2.
+# (0.02 J, the printed rounding); with --joints the block's one coordinate carries the unit's
+# net work (0.02 J) and no stance work (no feet). Bad input: a pose file without speeds (the
+# trial's coordinates.mot) and a missing file exit 1 with one line naming the file (and the
+# missing column); no --pose exits 2.
 # usage: work.sh GAITSIM SOURCE_DIR
 set -u
 gaitsim=$1 src=$2
@@ -35,6 +36,22 @@ parts = sum(rows["their " + k][2] for k in ("contractile elements (active fibre 
 ok = abs(de) > 1 and abs(s - de) <= 0.02 * abs(de) and abs(unit) > 1
 ok &= abs(unit - parts) <= 0.02 and len(rows) == 14
 print(f"sum {s} J, change {de} J, unit {unit} J, parts {parts} J", file=sys.stderr)
+sys.exit(0 if ok else 1)
+PY
+
+"$gaitsim" work "$bench" --pose run/states.sto --joints >joints.txt 2>err.txt
+status=$?
+check "--joints: exit 0 (got $status)" test "$status" -eq 0
+check "--joints: the block's coordinate carries the unit's work ($(tail -1 joints.txt))" \
+  /usr/bin/python3 - joints.txt <<'PY'
+import sys
+rows = {}
+for line in open(sys.argv[1]):
+    cells = [c.strip() for c in line.strip().strip("|").split("|")]
+    if len(cells) == 5 and cells[0] not in ("source", "coordinate", "---"):
+        rows[cells[0]] = [float(c) for c in cells[1:]]
+drop, unit = rows["drop"], rows["muscle-tendon units"]
+ok = abs(drop[0] + drop[1] - unit[2]) <= 0.02 and drop[2] == 0 and drop[3] == 0
 sys.exit(0 if ok else 1)
 PY
 

@@ -147,8 +147,11 @@ def mechanical_work(gaitsim, model, pose_file):
     work MODEL --pose POSE_FILE --joints` (app/cmd_work.c: a markdown table of the sources, the
     energy balance and the distance, then the muscles' work per coordinate). PrepError naming
     gaitsim when it fails."""
-    res = subprocess.run([gaitsim, "work", model, "--pose", pose_file, "--joints"],
-                         capture_output=True, text=True)
+    try:
+        res = subprocess.run([gaitsim, "work", model, "--pose", pose_file, "--joints"],
+                             capture_output=True, text=True)
+    except OSError as e:
+        raise PrepError(gaitsim, f"cannot run ({e.strerror})")
     if res.returncode != 0:
         raise PrepError(gaitsim, f"work failed: {res.stderr.strip()}")
     rows, joints, distance = {}, {}, None
@@ -166,3 +169,28 @@ def mechanical_work(gaitsim, model, pose_file):
     if not rows or distance is None:
         raise PrepError(gaitsim, "work printed no table")
     return rows, distance, joints
+
+
+# Published human figures the mechanical work is compared with (docs/VALIDATION.md,
+# scripts/physiology_figures.py):
+# Zelik & Kuo 2010, J Exp Biol 213:4257, at 1.25 m/s: the soft tissues' negative work per
+# collision and their rebound after it (J), from joint work against centre-of-mass work
+SOFT_TISSUE_COLLISION_J, SOFT_TISSUE_REBOUND_J = 7.5, 4.0
+# Montgomery & Grabowski 2018, R Soc Open Sci 5:180550 (twenty adults, 1.00-1.50 m/s, stance,
+# sagittal joint work): the knee's share of the leg's negative work (0.39 at 1.00 m/s, 0.45 at
+# 1.50 m/s, over their slopes) and the ankle's of the positive (0.42 at every speed and slope)
+KNEE_NEGATIVE_SHARE, ANKLE_POSITIVE_SHARE = "0.39-0.45", "0.42"
+SAGITTAL = ("hip_flexion", "knee_flexion", "ankle_angle")
+
+
+def stance_work(joints, suffix):
+    """One leg's muscle work in stance at the SAGITTAL coordinates (suffix "" right, "_l" left;
+    mechanical_work's joints): (negative [hip, knee, ankle], positive [...], the knee's share of
+    the negative, the ankle's of the positive), or None when a coordinate is missing."""
+    work = [joints.get(c + suffix) for c in SAGITTAL]
+    if None in work:
+        return None
+    neg, pos = [w[3] for w in work], [w[2] for w in work]
+    return (neg, pos, neg[1] / sum(neg) if sum(neg) else float("nan"),
+            pos[2] / sum(pos) if sum(pos) else float("nan"))
+

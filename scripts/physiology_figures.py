@@ -45,8 +45,9 @@ import sys
 import xml.etree.ElementTree as ET
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gs_scriptlib import (PrepError, inspect_muscles, mechanical_work, read_json,  # noqa: E402
-                          read_storage)
+from gs_scriptlib import (ANKLE_POSITIVE_SHARE, KNEE_NEGATIVE_SHARE,  # noqa: E402
+                          SOFT_TISSUE_COLLISION_J, SOFT_TISSUE_REBOUND_J, PrepError,
+                          inspect_muscles, mechanical_work, read_json, read_storage, stance_work)
 from validation import BASAL_W_PER_KG, fit_ralston_form, ralston_gross_w_per_kg  # noqa: E402
 
 COORDINATES = ["pelvis_tz", "pelvis_rx", "hip_adduction", "hip_adduction_l", "knee_adduction",
@@ -300,23 +301,13 @@ def trunk_moments(gaitsim, folder):
         print(f"  {c:18s} {net[c]:7.1f} {summed[c]:7.1f}")
 
 
-# Zelik & Kuo 2010, J Exp Biol 213:4257, at 1.25 m/s: the soft tissues' negative work per
-# collision and their rebound after it (J), from joint work against centre-of-mass work
-SOFT_TISSUE_COLLISION_J, SOFT_TISSUE_REBOUND_J = 7.5, 4.0
-# Montgomery & Grabowski 2018, R Soc Open Sci 5:180550 (twenty adults, 1.00-1.50 m/s, stance,
-# sagittal joint work): the knee's share of the leg's negative work (0.39 at 1.00 m/s, 0.45 at
-# 1.50 m/s, over their slopes) and the ankle's of the positive (0.42 at every speed and slope)
-KNEE_NEGATIVE_SHARE, ANKLE_POSITIVE_SHARE = "0.39-0.45", "0.42"
-SAGITTAL = ("hip_flexion", "knee_flexion", "ankle_angle")
-
-
 def work_budget(gaitsim, folder):
     """The stride's mechanical work by source (`GAITSIM work`, mechanical_work): the contractile
     elements' positive and negative work per metre (J/(kg m)), the foot contact's negative and
     positive work per collision (half the stride's: two heel strikes; J), split into its normal
     forces (whose net is the Hunt-Crossley damping's loss) and friction, and the contractile
     positive work over the muscles' metabolic energy (metabolics.sto, when present); per leg, the
-    muscles' stance work at the SAGITTAL coordinates and the knee's and ankle's shares."""
+    muscles' stance work at hip, knee and ankle (stance_work) and the knee's and ankle's shares."""
     s = read_json(os.path.join(folder, "summary.json"))
     model = s.get("model")
     mass = s["body_weight_n"] / 9.81 if s.get("body_weight_n") else None
@@ -344,15 +335,15 @@ def work_budget(gaitsim, folder):
         line += f"; contractile positive work / muscles' metabolic energy {ce[0] / energy:.3f}"
     print(line)
     for side, suffix in (("right", ""), ("left", "_l")):
-        work = [joints.get(c + suffix) for c in SAGITTAL]
-        if None in work:
+        leg = stance_work(joints, suffix)
+        if leg is None:
             continue
-        neg, pos = [w[3] for w in work], [w[2] for w in work]
+        neg, pos, knee, ankle = leg
         print(f"  {side} leg in stance, the muscles' work at hip / knee / ankle (J): negative "
               + " / ".join(f"{x:.1f}" for x in neg) + ", positive "
               + " / ".join(f"{x:.1f}" for x in pos)
-              + f"; the knee's share of the negative {neg[1] / sum(neg):.2f}, the ankle's of the "
-              f"positive {pos[2] / sum(pos):.2f} (Montgomery & Grabowski 2018: "
+              + f"; the knee's share of the negative {knee:.2f}, the ankle's of the "
+              f"positive {ankle:.2f} (Montgomery & Grabowski 2018: "
               f"{KNEE_NEGATIVE_SHARE} and {ANKLE_POSITIVE_SHARE})")
 
 

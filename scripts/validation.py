@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """docs/VALIDATION.md from a main job's results: the project's figures against measurement.
 
-usage: scripts/validation.py [RESULTS] > docs/VALIDATION.md
+usage: scripts/validation.py [RESULTS] [--gaitsim GAITSIM] > docs/VALIDATION.md
 
 RESULTS (default results) is the folder `gaitsim run` writes: RESULTS/track (the tracking solve of
 mjmodels/trials/jw_ngait_og5) and the predictions RESULTS/sweep/predict_* (or RESULTS/predict_*).
@@ -12,8 +12,13 @@ the instrumented implant (eTibia; Fregly et al. 2012, J Orthop Res 30:503) as ea
 holds it (knee_contact.sto), the measured centres of pressure of the trial (grf.mot), and
 Ralston's energy-speed relation for level walking (Ralston 1958, Int Z Angew Physiol 17:277:
 gross metabolic rate 29 + 0.0053 v^2 cal/(kg min), v in m/min). The targets are those of the
-project's issues (#19 resolution, #20 physiology). Exit 1 with one line naming the file when an
-input is missing.
+project's issues (#19 resolution, #20 physiology). With --gaitsim (the built binary), also the
+mechanical work of the tracking solution and of each prediction (`GAITSIM work MODEL --pose
+DIR/states.sto --joints`, MODEL from summary.json) against published human figures: the foot
+contact's negative and positive work per collision against the soft tissues' (Zelik & Kuo 2010,
+J Exp Biol 213:4257), the knee's share of each leg's sagittal negative work in stance and the
+ankle's of the positive (Montgomery & Grabowski 2018, R Soc Open Sci 5:180550). Exit 1 with one
+line naming the file when an input is missing.
 """
 import glob
 import math
@@ -21,7 +26,9 @@ import os
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gs_scriptlib import PrepError, read_json, read_storage  # noqa: E402
+from gs_scriptlib import (ANKLE_POSITIVE_SHARE, KNEE_NEGATIVE_SHARE,  # noqa: E402
+                          SOFT_TISSUE_COLLISION_J, SOFT_TISSUE_REBOUND_J, PrepError,
+                          mechanical_work, read_json, read_storage, stance_work)
 from report import PAPER_MEASURED_STRIDE_TIME, PAPER_STRIDE_TIME, TABLE1  # noqa: E402
 
 CAL = 4.184             # J per cal
@@ -238,9 +245,54 @@ def predictions(folders):
               f"{', '.join(parts) or '-'} (paper: about 2.5 for soleus and gastrocnemius).\n")
 
 
+def mechanical(gaitsim, folders):
+    """The mechanical work section: per solution folder, `gaitsim work`'s foot contact per
+    collision (half the stride's) and each leg's stance shares (stance_work)."""
+    print("## Mechanical work against published human data\n")
+    print("From `gaitsim work MODEL --pose DIR/states.sto --joints` (docs/BENCHMARKS.md, \"Where "
+          "the mechanical energy goes\"): the foot contact spheres' negative and positive work "
+          "per collision (half the stride's; the model's stand-in for the heel pad and soft "
+          f"tissues: Zelik & Kuo 2010 measured {SOFT_TISSUE_COLLISION_J} J of soft-tissue "
+          f"negative work per collision and {SOFT_TISSUE_REBOUND_J} J of rebound at 1.25 m/s), "
+          "and per leg the knee's share of the muscles' negative work at hip_flexion, "
+          "knee_flexion and ankle_angle in stance and the ankle's of the positive (Montgomery & "
+          f"Grabowski 2018: {KNEE_NEGATIVE_SHARE} and {ANKLE_POSITIVE_SHARE}).\n")
+    row(["solution", "foot contact per collision: negative / positive (J)",
+         "knee's share of stance negative work r / l", "ankle's share of stance positive work "
+         "r / l"])
+    row(["---"] * 4)
+    for folder in folders:
+        path = os.path.join(folder, "summary.json")
+        s = read_json(path)
+        if not s.get("model"):
+            raise PrepError(path, "no model")
+        try:
+            rows, _, joints = mechanical_work(gaitsim, s["model"],
+                                              os.path.join(folder, "states.sto"))
+        except PrepError as e:
+            raise PrepError(folder, f"gaitsim {e.reason}")
+        foot = rows["foot contact spheres"]
+        legs = [stance_work(joints, suffix) for suffix in ("", "_l")]
+        name = ("tracking" if s.get("problem") == "tracking"
+                else f"prediction {fmt(s.get('speed_target_mps'), 1)} m/s")
+        row([name, f"{foot[1] / 2:.1f} / {foot[0] / 2:.1f}",
+             " / ".join("-" if leg is None else f"{leg[2]:.2f}" for leg in legs),
+             " / ".join("-" if leg is None else f"{leg[3]:.2f}" for leg in legs)])
+    print()
+
+
 def main(argv):
-    results = argv[1] if len(argv) > 1 else "results"
-    if len(argv) > 2 or results in ("-h", "--help"):
+    args = argv[1:]
+    gaitsim = None
+    if "--gaitsim" in args:
+        i = args.index("--gaitsim")
+        if i + 1 >= len(args):
+            print("validation: --gaitsim needs the binary's path", file=sys.stderr)
+            return 2
+        gaitsim = args[i + 1]
+        del args[i:i + 2]
+    results = args[0] if args else "results"
+    if len(args) > 1 or results in ("-h", "--help"):
         print(__doc__.split("\n\n")[1], file=sys.stderr)
         return 2
     try:
@@ -248,7 +300,9 @@ def main(argv):
                        glob.glob(os.path.join(results, "predict_*")))
         speeds = sorted(os.path.basename(p)[len("predict_"):] for p in preds)
         print("# Validation: the model's figures against measurement\n")
-        print(f"Generated by `scripts/validation.py {results} > docs/VALIDATION.md` from the "
+        option = f" --gaitsim {gaitsim}" if gaitsim else ""
+        print(f"Generated by `scripts/validation.py {results}{option} > docs/VALIDATION.md` from "
+              "the "
               "solutions of `gaitsim run` (`scripts/setup.sh && build/gaitsim run`, which writes "
               f"{results}/track and the predictions at 0.8 and 2.0 m/s)"
               + ("" if set(speeds) <= {"0.8", "2"} else
@@ -258,6 +312,10 @@ def main(argv):
               + ". Regenerate them to check.\n")
         tracking(os.path.join(results, "track"))
         predictions(preds)
+        if gaitsim:
+            mechanical(gaitsim, [os.path.join(results, "track")] + sorted(
+                preds, key=lambda p: read_json(os.path.join(p, "summary.json"))
+                .get("speed_target_mps", 0)))
         print("## References\n")
         print("- Lin Y-C, Walter JP, Pandy MG (2018). Predictive simulations of neuromuscular "
               "coordination and joint-contact loading in human gait. Ann Biomed Eng 46:1216: "
@@ -272,6 +330,16 @@ def main(argv):
               "muscles' (Umberger 2010).")
         print("- Umberger BR (2010). Stance and swing phase costs in human walking. J R Soc "
               "Interface 7:1329-1340: the model's muscle energy rates.")
+        if gaitsim:
+            print("- Zelik KE, Kuo AD (2010). Human walking isn't all hard work: evidence of soft "
+                  "tissue contributions to energy dissipation and return. J Exp Biol "
+                  "213:4257-4264: at 1.25 m/s about 7.5 J of soft-tissue negative work per "
+                  "collision, 4 J of rebound after it.")
+            print("- Montgomery JR, Grabowski AM (2018). The contributions of ankle, knee and hip "
+                  "joint work to individual leg work change during uphill and downhill walking "
+                  "over a range of speeds. R Soc Open Sci 5:180550: the knee's share of the "
+                  "leg's stance negative work 0.39 at 1.00 m/s, 0.45 at 1.50 m/s; the ankle's of "
+                  "the positive 0.42.")
         print("- Margaria R (1968). Positive and negative work performances and their efficiencies "
               "in human locomotion. Int Z Angew Physiol 25:339-351: muscle's efficiency in "
               f"positive work about {MUSCLE_EFFICIENCY}.\n")

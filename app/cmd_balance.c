@@ -40,18 +40,6 @@ static const char* kBalanceUsage =
     "           the force along the shank and along the knee's lateral axis, that axis's\n"
     "           tilt (+ lateral end up)\n";
 
-// the ground reactions of the table at time, in the model world
-static void loads_at(const gsTable* g, const int* col, double time, gsFootLoad load[2]) {
-  for (int s = 0; s < 2; s++) {
-    double v[9];
-    for (int k = 0; k < 9; k++) v[k] = gs_table_value_at(g, col[9 * s + k], time);
-    gs_balance_from_opensim(v, load[s].force);
-    gs_balance_from_opensim(v + 3, load[s].cop);
-    gs_balance_from_opensim(v + 6, load[s].torque);
-    load[s].loaded = load[s].force[2] > BALANCE_STANCE_N;
-  }
-}
-
 typedef struct stat_ {
   double sum, sumsq, lo, hi;
   int n;
@@ -118,14 +106,10 @@ int gs_cmd_balance(int argc, char** argv) {
     goto done;
   }
   if (gs_app_read_table(m, grf, &g) != 0) goto done;
-  int col[18];
-  for (int k = 0; k < 18; k++) {
-    col[k] = gs_table_column(&g, gs_grf_labels[k]);
-    if (col[k] < 0) {
-      fprintf(stderr, "gaitsim: %s: no column %s (OpenSim ExternalLoads names expected)\n", grf,
-              gs_grf_labels[k]);
-      goto done;
-    }
+  int col[GS_GRF_NCOL];
+  if (gs_balance_grf_columns(&g, col, err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s: %s\n", grf, err);
+    goto done;
   }
   // qpos and qvel of every row; speeds from the file when it has them all, else differences
   int n = t.nrow, nq = m->nq, nv = m->nv;
@@ -136,23 +120,7 @@ int gs_cmd_balance(int argc, char** argv) {
     fprintf(stderr, "gaitsim: balance: out of memory\n");
     goto done;
   }
-  for (int i = 0; i < n; i++) {
-    mj_resetData(m, d);
-    gs_state_apply(m, &t, &map, t.time[i], d);
-    mju_copy(q + i * nq, d->qpos, nq);
-    mju_copy(v + i * nv, d->qvel, nv);
-  }
-  // central differences between the neighbouring rows (one-sided at the ends)
-  int speeds = map.nv_found == nv;
-  for (int i = 0; !speeds && i < n; i++) {
-    int i0 = i > 0 ? i - 1 : 0, i1 = i < n - 1 ? i + 1 : n - 1;
-    mj_differentiatePos(m, v + i * nv, t.time[i1] - t.time[i0], q + i0 * nq, q + i1 * nq);
-  }
-  for (int i = 0; i < n; i++) {
-    int i0 = i > 0 ? i - 1 : 0, i1 = i < n - 1 ? i + 1 : n - 1;
-    for (int k = 0; k < nv; k++)
-      a[i * nv + k] = (v[i1 * nv + k] - v[i0 * nv + k]) / (t.time[i1] - t.time[i0]);
-  }
+  int speeds = gs_app_pose_kinematics(m, d, &t, &map, q, v, a);
   stat cop_hip[2] = {0}, cop_com[2] = {0}, abd[2] = {0}, mom[2] = {0}, ang = {0}, bend = {0},
        sway = {0}, resf = {0}, resm = {0}, knee[2] = {{0}};
   double weight = mj_getTotalmass(m) * mju_norm3(m->opt.gravity);
@@ -169,7 +137,7 @@ int gs_cmd_balance(int argc, char** argv) {
     mju_copy(d->qpos, q + i * nq, nq);
     mju_copy(d->qvel, v + i * nv, nv);
     gsFootLoad load[2];
-    loads_at(&g, col, t.time[i], load);
+    gs_balance_loads_at(&g, col, t.time[i], BALANCE_STANCE_N, load);
     gsBalance b;
     gs_balance_eval(m, d, &spec, a + i * nv, load, &b);
     if (rows) {
@@ -230,7 +198,7 @@ int gs_cmd_balance(int argc, char** argv) {
       if (!loaded[2 * i + s]) continue;
       const gsBalance* b = &all[i];
       gsFootLoad load[2];
-      loads_at(&g, col, t.time[i], load);
+      gs_balance_loads_at(&g, col, t.time[i], BALANCE_STANCE_N, load);
       printf("| %.4f | %.1f | %.2f | %.2f |", t.time[i],
              100 * (t.time[i] - t.time[0]) / (t.time[n - 1] - t.time[0]),
              100 * b->cop_foot_forward[s], 100 * b->cop_foot_lateral[s]);

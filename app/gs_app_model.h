@@ -52,6 +52,14 @@ int gs_app_require_coordinates(const mjModel* m, const gsTable* t, const char* p
 // Read the pose or states file at path and check it with gs_app_require_coordinates. Prints one
 // line and returns -1 otherwise.
 int gs_app_check_pose_file(const mjModel* m, const char* path);
+// Every row's qpos, qvel and qacc (n x nq, n x nv, n x nv; n = t->nrow >= 3) from table t
+// (mapped by map, in radians) for inverse dynamics: the speeds from the file when it has every
+// one, else by central differences of the rows (one-sided at the ends), the accelerations always
+// by central differences of the speeds. Returns 1 when the speeds came from the file, 0 when
+// differenced. d is scratch.
+int gs_app_pose_kinematics(const mjModel* m, mjData* d, const gsTable* t, const void* map,
+                           double* q, double* v, double* a);
+
 // The model to use on solution folder dir: `given` (a --model option) when not NULL, else the
 // model dir/summary.json names (copied into buf, size n), else GS_DEFAULT_MODEL.
 const char* gs_app_model_for_solution(const char* dir, const char* given, char* buf, int n);

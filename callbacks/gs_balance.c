@@ -72,6 +72,12 @@ static void knee_frame(const mjData* d, const gsBalanceSpec* spec, int s, const 
 
 void gs_balance_eval(const mjModel* m, mjData* d, const gsBalanceSpec* spec, const double* qacc,
                      const gsFootLoad load[2], gsBalance* out) {
+  gs_balance_eval_tau(m, d, spec, qacc, load, out, NULL);
+}
+
+void gs_balance_eval_tau(const mjModel* m, mjData* d, const gsBalanceSpec* spec,
+                         const double* qacc, const gsFootLoad load[2], gsBalance* out,
+                         double* tau_out) {
   gs_fwd_position(m, d);  // kinematics, centres of mass, M (d->qM); tendons finite
   mj_fwdVelocity(m, d);  // c (d->qfrc_bias), body velocities
   mj_subtreeVel(m, d);
@@ -114,6 +120,7 @@ void gs_balance_eval(const mjModel* m, mjData* d, const gsBalanceSpec* spec, con
     int knee = spec->knee_adduction[s];
     out->knee_adduction_moment[s] = knee >= 0 ? tau[m->jnt_dofadr[knee]] : NAN;
   }
+  if (tau_out) mju_copy(tau_out, tau, m->nv);
   // the root's six dofs: pelvis_tx, _ty, _tz (slides) then pelvis_rz, _rx, _ry (hinges)
   int r0 = m->body_dofadr[spec->root_body], six = m->body_dofnum[spec->root_body] == 6;
   for (int k = 0; k < 3; k++) {
@@ -125,3 +132,28 @@ void gs_balance_eval(const mjModel* m, mjData* d, const gsBalanceSpec* spec, con
   out->lumbar_bending =
       spec->lumbar_bending >= 0 ? d->qpos[m->jnt_qposadr[spec->lumbar_bending]] : NAN;
 }
+
+int gs_balance_grf_columns(const gsTable* g, int col[GS_GRF_NCOL], char* err, int errsz) {
+  for (int k = 0; k < GS_GRF_NCOL; k++) {
+    col[k] = gs_table_column(g, gs_grf_labels[k]);
+    if (col[k] < 0) {
+      snprintf(err, (size_t)errsz, "no column %s (OpenSim ExternalLoads names expected)",
+               gs_grf_labels[k]);
+      return -1;
+    }
+  }
+  return 0;
+}
+
+void gs_balance_loads_at(const gsTable* g, const int col[GS_GRF_NCOL], double time,
+                         double stance_n, gsFootLoad load[2]) {
+  for (int s = 0; s < 2; s++) {
+    double v[9];
+    for (int k = 0; k < 9; k++) v[k] = gs_table_value_at(g, col[9 * s + k], time);
+    gs_balance_from_opensim(v, load[s].force);
+    gs_balance_from_opensim(v + 3, load[s].cop);
+    gs_balance_from_opensim(v + 6, load[s].torque);
+    load[s].loaded = load[s].force[2] > stance_n;
+  }
+}
+

@@ -23,6 +23,9 @@
 
 #include <mujoco/mujoco.h>
 
+#include "callbacks/gs_state.h"
+#include "io/gs_table.h"
+
 // One foot's ground reaction in the model world: force (N), centre of pressure (m), free moment
 // (N m). loaded 0: no load (force ignored).
 typedef struct gsFootLoad_ {
@@ -91,6 +94,21 @@ int gs_balance_spec(const mjModel* m, gsBalanceSpec* spec, char* err, int errsz)
 // (d->qacc is overwritten).
 void gs_balance_eval(const mjModel* m, mjData* d, const gsBalanceSpec* spec, const double* qacc,
                      const gsFootLoad load[2], gsBalance* out);
+
+// As gs_balance_eval, and the whole net generalised force tau (nv; N or N m, the pelvis's six
+// entries the residuals) into tau_out when not NULL: M qdd + c - sum J^T [F; T].
+void gs_balance_eval_tau(const mjModel* m, mjData* d, const gsBalanceSpec* spec,
+                         const double* qacc, const gsFootLoad load[2], gsBalance* out,
+                         double* tau_out);
+
+// The columns of a ground reaction table (gs_grf_labels' 18 names, e.g. a grf.mot) into col.
+// 0, or -1 with the missing name in err.
+int gs_balance_grf_columns(const gsTable* g, int col[GS_GRF_NCOL], char* err, int errsz);
+
+// Both feet's loads at time (s; the table interpolated linearly, in the model world), each
+// loaded when its vertical force exceeds stance_n (N).
+void gs_balance_loads_at(const gsTable* g, const int col[GS_GRF_NCOL], double time,
+                         double stance_n, gsFootLoad load[2]);
 
 // An OpenSim ground-frame vector (Y up, Z right) in the model world (Z up, Y left):
 // (x, y, z)_world = (x, -z, y)_OpenSim.

@@ -171,6 +171,28 @@ def mechanical_work(gaitsim, model, pose_file):
     return rows, distance, joints
 
 
+def inverse_dynamics_work(gaitsim, model, pose_file, grf_file):
+    """{coordinate: (positive, negative, positive in stance, negative in stance) J}: the net
+    joint work of inverse dynamics from `GAITSIM work MODEL --pose POSE_FILE --grf GRF_FILE`
+    (app/cmd_work.c), e.g. of a trial's measured gait. PrepError naming gaitsim when it fails."""
+    try:
+        res = subprocess.run([gaitsim, "work", model, "--pose", pose_file, "--grf", grf_file],
+                             capture_output=True, text=True)
+    except OSError as e:
+        raise PrepError(gaitsim, f"cannot run ({e.strerror})")
+    if res.returncode != 0:
+        raise PrepError(gaitsim, f"work failed: {res.stderr.strip()}")
+    joints = {}
+    for line in res.stdout.splitlines():
+        cells = [c.strip() for c in line.strip().strip("|").split("|")]
+        if line.startswith("|") and len(cells) == 5 and cells[0] != "coordinate" \
+                and cells[0][:3] != "---":
+            joints[cells[0]] = tuple(float(c) for c in cells[1:5])
+    if not joints:
+        raise PrepError(gaitsim, "work printed no joint table")
+    return joints
+
+
 # Published human figures the mechanical work is compared with (docs/VALIDATION.md,
 # scripts/physiology_figures.py):
 # Zelik & Kuo 2010, J Exp Biol 213:4257, at 1.25 m/s: the soft tissues' negative work per

@@ -28,7 +28,8 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from gs_scriptlib import (ANKLE_POSITIVE_SHARE, KNEE_NEGATIVE_SHARE,  # noqa: E402
                           SOFT_TISSUE_COLLISION_J, SOFT_TISSUE_REBOUND_J, PrepError,
-                          mechanical_work, read_json, read_storage, stance_work)
+                          inverse_dynamics_work, mechanical_work, read_json, read_storage,
+                          stance_work)
 from report import PAPER_MEASURED_STRIDE_TIME, PAPER_STRIDE_TIME, TABLE1  # noqa: E402
 
 CAL = 4.184             # J per cal
@@ -246,8 +247,10 @@ def predictions(folders):
 
 
 def mechanical(gaitsim, folders):
-    """The mechanical work section: per solution folder, `gaitsim work`'s foot contact per
-    collision (half the stride's) and each leg's stance shares (stance_work)."""
+    """The mechanical work section: the measured gait's net joint work by inverse dynamics
+    (`gaitsim work MODEL --pose TRIAL/coordinates.mot --grf TRIAL/grf.mot`, the track's trial),
+    then per solution folder (the track first) `gaitsim work`'s foot contact per collision (half
+    the stride's) and each leg's stance shares (stance_work)."""
     print("## Mechanical work against published human data\n")
     print("From `gaitsim work MODEL --pose DIR/states.sto --joints` (docs/BENCHMARKS.md, \"Where "
           "the mechanical energy goes\"): the foot contact spheres' negative and positive work "
@@ -256,11 +259,27 @@ def mechanical(gaitsim, folders):
           f"negative work per collision and {SOFT_TISSUE_REBOUND_J} J of rebound at 1.25 m/s), "
           "and per leg the knee's share of the muscles' negative work at hip_flexion, "
           "knee_flexion and ankle_angle in stance and the ankle's of the positive (Montgomery & "
-          f"Grabowski 2018: {KNEE_NEGATIVE_SHARE} and {ANKLE_POSITIVE_SHARE}).\n")
+          f"Grabowski 2018: {KNEE_NEGATIVE_SHARE} and {ANKLE_POSITIVE_SHARE}); the first row "
+          "is the trial JW walked, by inverse dynamics of its coordinates and plates (`gaitsim "
+          "work MODEL --pose TRIAL/coordinates.mot --grf TRIAL/grf.mot`).\n")
     row(["solution", "foot contact per collision: negative / positive (J)",
          "knee's share of stance negative work r / l", "ankle's share of stance positive work "
          "r / l"])
     row(["---"] * 4)
+    track = read_json(os.path.join(folders[0], "summary.json"))
+    trial = track.get("trial")
+    if trial and track.get("model"):
+        # JW's own gait: the net joint work of inverse dynamics of the trial he walked
+        try:
+            joints = inverse_dynamics_work(gaitsim, track["model"],
+                                           os.path.join(trial, "coordinates.mot"),
+                                           os.path.join(trial, "grf.mot"))
+        except PrepError as e:
+            raise PrepError(trial, f"gaitsim {e.reason}")
+        legs = [stance_work(joints, suffix) for suffix in ("", "_l")]
+        row(["measured (the trial, inverse dynamics: net joint work)", "-",
+             " / ".join("-" if leg is None else f"{leg[2]:.2f}" for leg in legs),
+             " / ".join("-" if leg is None else f"{leg[3]:.2f}" for leg in legs)])
     for folder in folders:
         path = os.path.join(folder, "summary.json")
         s = read_json(path)

@@ -14,6 +14,7 @@
 import json
 import os
 import subprocess
+import sys
 import tempfile
 
 
@@ -215,4 +216,24 @@ def stance_work(joints, suffix):
     neg, pos = [w[3] for w in work], [w[2] for w in work]
     return (neg, pos, neg[1] / sum(neg) if sum(neg) else float("nan"),
             pos[2] / sum(pos) if sum(pos) else float("nan"))
+
+
+def results_and_gaitsim(argv, prog, doc):
+    """(RESULTS, GAITSIM or None) from a script's arguments `[RESULTS] [--gaitsim GAITSIM]`
+    (RESULTS default "results"), or an exit status (int) after printing the usage (the second
+    paragraph of doc) or the error when they are wrong."""
+    args = argv[1:]
+    gaitsim = None
+    if "--gaitsim" in args:
+        i = args.index("--gaitsim")
+        if i + 1 >= len(args):
+            print(f"{prog}: --gaitsim needs the binary's path", file=sys.stderr)
+            return 2
+        gaitsim = args[i + 1]
+        del args[i:i + 2]
+    results = args[0] if args else "results"
+    if len(args) > 1 or results in ("-h", "--help"):
+        print(doc.split("\n\n")[1], file=sys.stderr)
+        return 2
+    return results, gaitsim
 

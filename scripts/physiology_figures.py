@@ -47,7 +47,8 @@ import xml.etree.ElementTree as ET
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from gs_scriptlib import (ANKLE_POSITIVE_SHARE, KNEE_NEGATIVE_SHARE,  # noqa: E402
                           SOFT_TISSUE_COLLISION_J, SOFT_TISSUE_REBOUND_J, PrepError,
-                          inspect_muscles, mechanical_work, read_json, read_storage, stance_work)
+                          inspect_muscles, mechanical_work, read_json, read_storage,
+                          results_and_gaitsim, stance_work)
 from validation import BASAL_W_PER_KG, fit_ralston_form, ralston_gross_w_per_kg  # noqa: E402
 
 COORDINATES = ["pelvis_tz", "pelvis_rx", "hip_adduction", "hip_adduction_l", "knee_adduction",
@@ -348,19 +349,10 @@ def work_budget(gaitsim, folder):
 
 
 def main(argv):
-    args = argv[1:]
-    gaitsim = None
-    if "--gaitsim" in args:
-        i = args.index("--gaitsim")
-        if i + 1 >= len(args):
-            print("physiology_figures: --gaitsim needs the binary's path", file=sys.stderr)
-            return 2
-        gaitsim = args[i + 1]
-        del args[i:i + 2]
-    results = args[0] if args else "results"
-    if len(args) > 1 or results in ("-h", "--help"):
-        print(__doc__.split("\n\n")[1], file=sys.stderr)
-        return 2
+    parsed = results_and_gaitsim(argv, "physiology_figures", __doc__)
+    if isinstance(parsed, int):
+        return parsed
+    results, gaitsim = parsed
     try:
         tracking(os.path.join(results, "track"))
         predictions = sorted(glob.glob(os.path.join(results, "sweep", "predict_*")))

@@ -29,7 +29,7 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from gs_scriptlib import (ANKLE_POSITIVE_SHARE, KNEE_NEGATIVE_SHARE,  # noqa: E402
                           SOFT_TISSUE_COLLISION_J, SOFT_TISSUE_REBOUND_J, PrepError,
                           inverse_dynamics_work, mechanical_work, read_json, read_storage,
-                          stance_work)
+                          results_and_gaitsim, stance_work)
 from report import PAPER_MEASURED_STRIDE_TIME, PAPER_STRIDE_TIME, TABLE1  # noqa: E402
 
 CAL = 4.184             # J per cal
@@ -301,19 +301,10 @@ def mechanical(gaitsim, folders):
 
 
 def main(argv):
-    args = argv[1:]
-    gaitsim = None
-    if "--gaitsim" in args:
-        i = args.index("--gaitsim")
-        if i + 1 >= len(args):
-            print("validation: --gaitsim needs the binary's path", file=sys.stderr)
-            return 2
-        gaitsim = args[i + 1]
-        del args[i:i + 2]
-    results = args[0] if args else "results"
-    if len(args) > 1 or results in ("-h", "--help"):
-        print(__doc__.split("\n\n")[1], file=sys.stderr)
-        return 2
+    parsed = results_and_gaitsim(argv, "validation", __doc__)
+    if isinstance(parsed, int):
+        return parsed
+    results, gaitsim = parsed
     try:
         preds = sorted(glob.glob(os.path.join(results, "sweep", "predict_*")) +
                        glob.glob(os.path.join(results, "predict_*")))

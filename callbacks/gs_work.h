@@ -6,13 +6,14 @@
 // Biol 213:4257), the implant knee's contact and ligaments, the joint-limit moments.
 //
 // Power of a generalised force f on the body: P = f . qdot (W; > 0 when it adds energy). MuJoCo's
-// equations of motion M qdd + c = f_passive + f_actuator + f_constraint + f_applied give, with
-// M' - 2C skew-symmetric (Featherstone 2008, Rigid Body Dynamics Algorithms, sec. 1.x; Siciliano
-// et al. 2009, Robotics, eq. 7.49):
+// equations of motion M qdd + c = f_passive + f_actuator + f_constraint + f_applied give, since
+// qdot' (M' / 2 - C) qdot = 0 for the Coriolis and centrifugal part C qdot of c (the skew
+// symmetry of M' - 2C; Siciliano et al. 2009, Robotics: Modelling, Planning and Control, ch. 7):
 //   d/dt (KE + PE) = (f_passive + f_actuator + f_constraint + f_applied) . qdot            (W)
 // with KE = qdot' M qdot / 2 and PE = -m_total g . c_com, the gravity's power being -dPE/dt =
 // m_total g . v_com. Every term below is one piece of the right-hand side; their sum equals the
-// left-hand side exactly at a state (tests/test_work.c checks the integral over a simulation).
+// left-hand side exactly at a state (tests/test_work.c checks it by central differences along a
+// state's own motion; the app integrates each term over a solution's rows).
 //
 // Muscles (gs_muscle.h's Hill model; gaitsim muscle actuators only):
 //   muscle-tendon unit i:  P_i = -F_T,i v_MT,i    (F_T the tendon tension >= 0, v_MT the

@@ -17,14 +17,16 @@
 // worker threads of one solve (-)
 #define GO_THREADS 2
 // Ipopt iteration limits (-)
-#define GO_MAX_ITER 2500           // each prediction: gaitsim predict, each speed of sweep and of
+#define GO_MAX_ITER 4000           // each prediction: gaitsim predict, each speed of sweep and of
                                    // run's main job (--max-iter). An iteration budget, not a time
                                    // limit, so results do not depend on the load of the machine;
                                    // at 80 nodes the main job's predictions stop after 840
-                                   // (0.8 m/s) and 1660 (2.0 m/s) iterations; the default
-                                   // sweep's 1.0, 1.2 and 1.6 m/s stop at this limit (1.2 m/s
-                                   // settles after 2806 given 4000: docs/BENCHMARKS.md, "The
-                                   // whole sweep on the current model")
+                                   // (0.8 m/s) and 1660 (2.0 m/s) iterations, and every speed of
+                                   // the default sweep settles within it (1.0, 1.2 and 1.6 m/s
+                                   // after 3525, 2806 and 3186: docs/BENCHMARKS.md, "The whole
+                                   // sweep on the current model"); a larger limit retraces a
+                                   // smaller one's iterations bitwise, so it changes no solve that
+                                   // settled within it
 #define GO_MAX_ITER_TRACK 60       // track's main solve, Gauss-Newton from the trial's guess at
                                    // barrier GO_GN_MU_INIT, before the refinement (--max-iter).
                                    // At N = 80 it brings the violation from 182 to about 0.1 at

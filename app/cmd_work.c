@@ -53,8 +53,7 @@ static const char* kWorkUsage =
 
 // the file must carry every speed and every muscle state: the work needs the velocities and
 // the muscle forces, which an absent column would silently zero
-static int require_states(const mjModel* m, const gsTable* t, const gsStateMap* map,
-                          const char* path) {
+static int require_states(const mjModel* m, const gsStateMap* map, const char* path) {
   for (int j = 0; j < m->njnt; j++) {
     int dof = m->jnt_dofadr[j];
     if (m->jnt_type[j] != mjJNT_HINGE && m->jnt_type[j] != mjJNT_SLIDE) continue;
@@ -78,7 +77,6 @@ static int require_states(const mjModel* m, const gsTable* t, const gsStateMap* 
       return -1;
     }
   }
-  (void)t;
   return 0;
 }
 
@@ -169,7 +167,7 @@ static void dof_work_print(const dofWork* w, const mjModel* m, const char* what)
 // the sources' work and, with joints, the muscles' work per coordinate, over a states file
 static int work_of_states(const mjModel* m, mjData* d, const char* path, const char* pose,
                           const gsTable* t, const gsStateMap* map, int joints) {
-  if (require_states(m, t, map, pose) != 0) return -1;
+  if (require_states(m, map, pose) != 0) return -1;
   if (t->nrow < 2) {
     fprintf(stderr, "gaitsim: %s: %d row; the work needs at least 2\n", pose, t->nrow);
     return -1;

@@ -253,18 +253,17 @@ const char* gs_app_model_for_solution(const char* dir, const char* given, char* 
   return gs_app_solution_model(dir, buf, n) ? buf : GS_DEFAULT_MODEL;
 }
 
-int gs_app_pose_kinematics(const mjModel* m, mjData* d, const gsTable* t, const void* map,
-                           double* q, double* v, double* a) {
-  const gsStateMap* sm = (const gsStateMap*)map;
+int gs_app_pose_kinematics(const mjModel* m, mjData* d, const gsTable* t,
+                           const gsStateMap* map, double* q, double* v, double* a) {
   int n = t->nrow, nq = m->nq, nv = m->nv;
   for (int i = 0; i < n; i++) {
     mj_resetData(m, d);
-    gs_state_apply(m, t, sm, t->time[i], d);
+    gs_state_apply(m, t, map, t->time[i], d);
     mju_copy(q + i * nq, d->qpos, nq);
     mju_copy(v + i * nv, d->qvel, nv);
   }
   // central differences between the neighbouring rows (one-sided at the ends)
-  int speeds = sm->nv_found == nv;
+  int speeds = map->nv_found == nv;
   for (int i = 0; !speeds && i < n; i++) {
     int i0 = i > 0 ? i - 1 : 0, i1 = i < n - 1 ? i + 1 : n - 1;
     mj_differentiatePos(m, v + i * nv, t->time[i1] - t->time[i0], q + i0 * nq, q + i1 * nq);

@@ -5,6 +5,7 @@
 
 #include <mujoco/mujoco.h>
 
+#include "callbacks/gs_state.h"
 #include "io/gs_table.h"
 
 // Load MODEL and prepare it for gaitsim's physics (gs_physics_prepare, gs_physics_install).
@@ -57,8 +58,8 @@ int gs_app_check_pose_file(const mjModel* m, const char* path);
 // one, else by central differences of the rows (one-sided at the ends), the accelerations always
 // by central differences of the speeds. Returns 1 when the speeds came from the file, 0 when
 // differenced. d is scratch.
-int gs_app_pose_kinematics(const mjModel* m, mjData* d, const gsTable* t, const void* map,
-                           double* q, double* v, double* a);
+int gs_app_pose_kinematics(const mjModel* m, mjData* d, const gsTable* t,
+                           const gsStateMap* map, double* q, double* v, double* a);
 
 // The model to use on solution folder dir: `given` (a --model option) when not NULL, else the
 // model dir/summary.json names (copied into buf, size n), else GS_DEFAULT_MODEL.

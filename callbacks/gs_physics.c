@@ -167,14 +167,10 @@ int gs_physics_sphere_contact(const mjModel* m, const mjData* d, int g, gsContac
 }
 
 void gs_physics_contact_passive(const mjModel* m, mjData* d) {
-  gs_physics_foot_contact_passive(m, d, 0);
-}
-
-void gs_physics_foot_contact_passive(const mjModel* m, mjData* d, int side) {
   const mjtNum zero[3] = {0, 0, 0};
   for (int g = 0; g < m->ngeom; g++) {
     gsContactOut out;
-    if ((side && gs_geom_contact_side(m, g) != side) || !gs_physics_sphere_contact(m, d, g, &out)) {
+    if (!gs_physics_sphere_contact(m, d, g, &out)) {
       continue;
     }
     mjtNum force[3] = {out.force[0], out.force[1], out.force[2]};

@@ -75,9 +75,6 @@ int gs_physics_step(const mjModel* m, mjData* d, mjtNum* fT_dot);
 // exposed for tests). Needs positions and velocities (mj_fwdPosition, mj_fwdVelocity's comVel).
 void gs_physics_contact_passive(const mjModel* m, mjData* d);
 
-// The same for one foot's spheres only (side 'r' or 'l'; 0: every sphere).
-void gs_physics_foot_contact_passive(const mjModel* m, mjData* d, int side);
-
 // Hunt-Crossley contact of geom g with the floor at the current state (gs_contact_sphere with the
 // sphere's centre velocity and its body's velocity at the contact point): force on the body, where
 // it acts, depth and its rate. Returns 1, or 0 (out untouched) when g is not a contact sphere.

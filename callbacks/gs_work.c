@@ -52,21 +52,26 @@ void gs_work_powers(const mjModel* m, mjData* d, gsPowers* p) {
   mju_copy(whole, d->qfrc_passive, nv);
   double all = mju_dot(whole, d->qvel, nv), ours = 0;
   mju_zero(d->qfrc_passive, nv);
+  // each foot: its spheres' forces applied as gs_physics_contact_passive applies them, and
+  // their normal forces' power -Fn d' from the same evaluation
   const int sides[2] = {'r', 'l'};
+  const mjtNum zero[3] = {0, 0, 0};
   for (int s = 0; s < 2; s++) {
-    gs_physics_foot_contact_passive(m, d, sides[s]);
-    double pf = take_passive(m, d);
-    split(pf, &p->foot_pos, &p->foot_neg);
-    ours += pf;
     double normal = 0;
     for (int g = 0; g < m->ngeom; g++) {
       gsContactOut co;
       if (gs_geom_contact_side(m, g) != sides[s] || !gs_physics_sphere_contact(m, d, g, &co))
         continue;
+      mjtNum force[3] = {co.force[0], co.force[1], co.force[2]};
+      mjtNum point[3] = {co.point[0], co.point[1], co.point[2]};
+      mj_applyFT(m, d, force, zero, point, m->geom_bodyid[g], d->qfrc_passive);
       double pn = -co.normal_force * co.depth_rate;
       split(pn, &p->foot_normal_pos, &p->foot_normal_neg);
       normal += pn;
     }
+    double pf = take_passive(m, d);
+    split(pf, &p->foot_pos, &p->foot_neg);
+    ours += pf;
     p->foot_friction += pf - normal;
   }
   gs_knee_passive(m, d, NULL);

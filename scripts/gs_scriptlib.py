@@ -116,18 +116,27 @@ def storage_text(name, labels, rows, in_degrees, notes=(), cell=lambda v: f"{v:.
     return "\n".join(out) + "\n"
 
 
+def run_gaitsim(gaitsim, args):
+    """The standard output of `GAITSIM ARGS...`; PrepError naming gaitsim when it cannot be run
+    or exits non-zero (the reason: args[0] and its stderr)."""
+    try:
+        res = subprocess.run([gaitsim] + args, capture_output=True, text=True)
+    except OSError as e:
+        raise PrepError(gaitsim, f"cannot run ({e.strerror})")
+    if res.returncode != 0:
+        raise PrepError(gaitsim, f"{args[0]} failed: {res.stderr.strip()}")
+    return res.stdout
+
+
 def inspect_muscles(gaitsim, model, pose_file, time, activation=None):
     """{muscle: {"lMT" (m), "lM" (m), "lM_norm" (-), "F" (N), "Edot" (W), "arms": {coordinate:
     moment arm (m or m/m)}}} in the model's order, from `GAITSIM inspect MODEL --pose POSE_FILE
     --time TIME [--activation A]` (app/cmd_inspect.c: a header line starting "muscle", then one
     row per muscle, then the contact spheres). PrepError naming gaitsim when it fails."""
-    cmd = [gaitsim, "inspect", model, "--pose", pose_file, "--time", repr(time)]
+    args = ["inspect", model, "--pose", pose_file, "--time", repr(time)]
     if activation is not None:
-        cmd += ["--activation", repr(activation)]
-    res = subprocess.run(cmd, capture_output=True, text=True)
-    if res.returncode != 0:
-        raise PrepError(gaitsim, f"inspect failed: {res.stderr.strip()}")
-    rows = res.stdout.splitlines()
+        args += ["--activation", repr(activation)]
+    rows = run_gaitsim(gaitsim, args).splitlines()
     head = next((k for k, r in enumerate(rows) if r.startswith("muscle ")), None)
     if head is None:
         raise PrepError(gaitsim, "inspect printed no muscle table")
@@ -142,30 +151,34 @@ def inspect_muscles(gaitsim, model, pose_file, time, activation=None):
     return out
 
 
+def _table_cells(line):
+    """The cells of a data row of one of `gaitsim work`'s markdown tables, else None (a header
+    or separator row, or a line outside the tables)."""
+    if not line.startswith("|"):
+        return None
+    cells = [c.strip() for c in line.strip().strip("|").split("|")]
+    if cells[0] in ("source", "coordinate") or cells[0].startswith("---"):
+        return None
+    return cells
+
+
 def mechanical_work(gaitsim, model, pose_file):
     """({source: (positive, negative, net) J}, distance the centre of mass travelled (m),
     {coordinate: (positive, negative, positive in stance, negative in stance) J}) from `GAITSIM
     work MODEL --pose POSE_FILE --joints` (app/cmd_work.c: a markdown table of the sources, the
     energy balance and the distance, then the muscles' work per coordinate). PrepError naming
     gaitsim when it fails."""
-    try:
-        res = subprocess.run([gaitsim, "work", model, "--pose", pose_file, "--joints"],
-                             capture_output=True, text=True)
-    except OSError as e:
-        raise PrepError(gaitsim, f"cannot run ({e.strerror})")
-    if res.returncode != 0:
-        raise PrepError(gaitsim, f"work failed: {res.stderr.strip()}")
+    out = run_gaitsim(gaitsim, ["work", model, "--pose", pose_file, "--joints"])
     rows, joints, distance = {}, {}, None
-    for line in res.stdout.splitlines():
-        cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        header = cells[0] in ("source", "coordinate") or cells[0][:3] == "---"
-        if not line.startswith("|") or header:
-            if line.startswith("centre of mass travelled"):
-                distance = float(line.split()[4])
+    for line in out.splitlines():
+        if line.startswith("centre of mass travelled"):
+            distance = float(line.split()[4])
+        cells = _table_cells(line)
+        if cells is None or len(cells) != 5:
             continue
-        if len(cells) == 5 and distance is None:
+        if distance is None:
             rows[cells[0]] = tuple(float(c) for c in cells[1:4])
-        elif len(cells) == 5:
+        else:
             joints[cells[0]] = tuple(float(c) for c in cells[1:5])
     if not rows or distance is None:
         raise PrepError(gaitsim, "work printed no table")
@@ -176,18 +189,11 @@ def inverse_dynamics_work(gaitsim, model, pose_file, grf_file):
     """{coordinate: (positive, negative, positive in stance, negative in stance) J}: the net
     joint work of inverse dynamics from `GAITSIM work MODEL --pose POSE_FILE --grf GRF_FILE`
     (app/cmd_work.c), e.g. of a trial's measured gait. PrepError naming gaitsim when it fails."""
-    try:
-        res = subprocess.run([gaitsim, "work", model, "--pose", pose_file, "--grf", grf_file],
-                             capture_output=True, text=True)
-    except OSError as e:
-        raise PrepError(gaitsim, f"cannot run ({e.strerror})")
-    if res.returncode != 0:
-        raise PrepError(gaitsim, f"work failed: {res.stderr.strip()}")
+    out = run_gaitsim(gaitsim, ["work", model, "--pose", pose_file, "--grf", grf_file])
     joints = {}
-    for line in res.stdout.splitlines():
-        cells = [c.strip() for c in line.strip().strip("|").split("|")]
-        if line.startswith("|") and len(cells) == 5 and cells[0] != "coordinate" \
-                and cells[0][:3] != "---":
+    for line in out.splitlines():
+        cells = _table_cells(line)
+        if cells is not None and len(cells) == 5:
             joints[cells[0]] = tuple(float(c) for c in cells[1:5])
     if not joints:
         raise PrepError(gaitsim, "work printed no joint table")

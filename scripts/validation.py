@@ -246,6 +246,13 @@ def predictions(folders):
               f"{', '.join(parts) or '-'} (paper: about 2.5 for soleus and gastrocnemius).\n")
 
 
+def share_cells(joints):
+    """The two share cells of a mechanical-work row: the knee's of the stance negative work and
+    the ankle's of the positive, right / left ("-" for a leg without the coordinates)."""
+    legs = [stance_work(joints, suffix) for suffix in ("", "_l")]
+    return [" / ".join("-" if leg is None else f"{leg[k]:.2f}" for leg in legs) for k in (2, 3)]
+
+
 def mechanical(gaitsim, folders):
     """The mechanical work section: the measured gait's net joint work by inverse dynamics
     (`gaitsim work MODEL --pose TRIAL/coordinates.mot --grf TRIAL/grf.mot`, the track's trial),
@@ -276,10 +283,7 @@ def mechanical(gaitsim, folders):
                                            os.path.join(trial, "grf.mot"))
         except PrepError as e:
             raise PrepError(trial, f"gaitsim {e.reason}")
-        legs = [stance_work(joints, suffix) for suffix in ("", "_l")]
-        row(["measured (the trial, inverse dynamics: net joint work)", "-",
-             " / ".join("-" if leg is None else f"{leg[2]:.2f}" for leg in legs),
-             " / ".join("-" if leg is None else f"{leg[3]:.2f}" for leg in legs)])
+        row(["measured (the trial, inverse dynamics: net joint work)", "-"] + share_cells(joints))
     for folder in folders:
         path = os.path.join(folder, "summary.json")
         s = read_json(path)
@@ -291,12 +295,9 @@ def mechanical(gaitsim, folders):
         except PrepError as e:
             raise PrepError(folder, f"gaitsim {e.reason}")
         foot = rows["foot contact spheres"]
-        legs = [stance_work(joints, suffix) for suffix in ("", "_l")]
         name = ("tracking" if s.get("problem") == "tracking"
                 else f"prediction {fmt(s.get('speed_target_mps'), 1)} m/s")
-        row([name, f"{foot[1] / 2:.1f} / {foot[0] / 2:.1f}",
-             " / ".join("-" if leg is None else f"{leg[2]:.2f}" for leg in legs),
-             " / ".join("-" if leg is None else f"{leg[3]:.2f}" for leg in legs)])
+        row([name, f"{foot[1] / 2:.1f} / {foot[0] / 2:.1f}"] + share_cells(joints))
     print()
 
 

@@ -17,7 +17,9 @@ RESULTS (default results) is the folder `gaitsim run` writes. Prints:
     coordinates that leave the model's joint ranges (deg, or m for slides);
   - for the tracking solution and each prediction with a grf.mot: each knee's flexion in
     loading response, the most flexed over the first 20 % of the stride after its foot's
-    contact (vertical ground force above 20 N; deg);
+    contact (vertical ground force above 20 N; deg), and the leg muscles' metabolic energy
+    split by phase as Umberger 2010 splits it (swing, double and single support; his 1.3 m/s
+    gait: 0.29, 0.27, 0.44), metabolics.sto and grf.mot at the solution's nodes;
   - over three predictions or more, each group's power in Ralston's form a + b v^2 (least
     squares; W/kg, v in m/s): a, the cost per second whatever the speed, which makes the cost of
     transport fall with speed, and b; beside Ralston 1958's muscle share (his gross rate less the
@@ -117,6 +119,52 @@ def print_loading_response_knee(folder):
               f"{knee[0]:.1f}, left {knee[1]:.1f}")
 
 
+SWING_SHARE_UMBERGER = 0.29   # leg swing's share of the muscles' cost at 1.3 m/s (-)
+DOUBLE_SHARE_UMBERGER = 0.27  # double-limb support's share (-)
+SINGLE_SHARE_UMBERGER = 0.44  # single-limb support's share (-)
+
+
+def phase_costs(folder):
+    """The leg muscles' metabolic energy over the stride split by gait phase as Umberger 2010
+    (J R Soc Interface 7:1329) splits it: at each instant each leg's muscles count as swing
+    while its foot is off the ground (vertical force at most CONTACT_N), as double support while
+    both feet are on it, as single support while only theirs is. Trunk muscles are left out (his
+    model had none). Returns the three shares (swing, double, single), or None without grf.mot or
+    metabolics.sto."""
+    grf_path, met_path = os.path.join(folder, "grf.mot"), os.path.join(folder, "metabolics.sto")
+    if not os.path.exists(grf_path) or not os.path.exists(met_path):
+        return None
+    g, met = columns(grf_path), columns(met_path)
+    trunk = re.compile(GROUPS[0][1])
+    t = met["time"]
+    power = {"": [0.0] * len(t), "_l": [0.0] * len(t)}
+    for muscle, values in met.items():
+        if muscle in ("time", "total") or trunk.search(muscle):
+            continue
+        leg = power["_l" if muscle.endswith("_l") else ""]
+        for k, v in enumerate(values):
+            leg[k] += v
+    on = {side: [interp(x, g["time"], g[f"ground_force_{c}_vy"]) > CONTACT_N for x in t]
+          for side, c in (("", "r"), ("_l", "l"))}
+    phase = {"swing": [0.0] * len(t), "double": [0.0] * len(t), "single": [0.0] * len(t)}
+    for side, other in (("", "_l"), ("_l", "")):
+        for k in range(len(t)):
+            name = ("swing" if not on[side][k] else "double" if on[other][k] else "single")
+            phase[name][k] += power[side][k]
+    energy = {name: mean_over_time(t, y) for name, y in phase.items()}
+    total = sum(energy.values())
+    return tuple(energy[name] / total for name in ("swing", "double", "single"))
+
+
+def print_phase_costs(folder):
+    shares = phase_costs(folder)
+    if shares:
+        print(f"  leg muscles' cost by phase (Umberger 2010's split): swing {shares[0]:.2f}, "
+              f"double support {shares[1]:.2f}, single support {shares[2]:.2f} (his 1.3 m/s "
+              f"gait: {SWING_SHARE_UMBERGER}, {DOUBLE_SHARE_UMBERGER}, "
+              f"{SINGLE_SHARE_UMBERGER})")
+
+
 def tracking(track):
     s = read_json(os.path.join(track, "summary.json"))
     trial = s.get("trial")
@@ -135,6 +183,7 @@ def tracking(track):
         print(f"  {c:18s} {sum(d) / len(d):+8.3f} {rms:8.3f}  {sum(model[c]) / len(d):+8.2f} "
               f"{sum(m) / len(m):+8.2f}")
     print_loading_response_knee(track)
+    print_phase_costs(track)
 
 
 def prediction(folder):
@@ -163,6 +212,7 @@ def prediction(folder):
     outside = outside_ranges(s["model"], columns(os.path.join(folder, "states.sto")))
     print("  joint ranges (model): " + ("; ".join(outside) if outside else "all kept"))
     print_loading_response_knee(folder)
+    print_phase_costs(folder)
     return speed, power, total
 
 

@@ -82,6 +82,12 @@ check "joint ranges: lumbar_extension -17 below -15 deg" grep -qxF \
 check "loading-response knee flexion 12 / 9 deg" grep -qxF \
   "  loading-response knee flexion (deg; the most flexed over the first 20 % of the stride after contact): right 12.0, left 9.0" <<<"$out"
 check "no grf.mot for the track: no knee line" test "$(grep -c "loading-response" <<<"$out")" -eq 1
+# the vasti (right leg) at 100 W, sampled at 0, 0.25 ... 1 s: the right foot on at 0.25 and
+# 0.5 s (grf.mot interpolated; the left on at 0.25 too), so trapezoid weights 2 swing (0, 0.75,
+# 1 s), 1 double (0.25 s) and 1 single (0.5 s) of 4; the erector spinae (trunk) left out
+check "phase split 0.50 / 0.25 / 0.25" grep -qxF \
+  "  leg muscles' cost by phase (Umberger 2010's split): swing 0.50, double support 0.25, single support 0.25 (his 1.3 m/s gait: 0.29, 0.27, 0.44)" <<<"$out"
+check "no grf.mot for the track: no phase line" test "$(grep -c "by phase" <<<"$out")" -eq 1
 check "one prediction: no fit" test "$(grep -c "Ralston's form" <<<"$out")" -eq 0
 
 /usr/bin/python3 - <<'PY'

@@ -86,6 +86,12 @@ CONTACT_N = 20.0          # a foot is on the ground above this vertical ground f
 LOADING_RESPONSE = 0.2    # the stride fraction after contact searched for the knee's flexion (-)
 
 
+def foot_loaded(grf, column, times):
+    """Whether the foot carries more than CONTACT_N at each of times: grf's (columns of grf.mot)
+    vertical force column, interpolated."""
+    return [interp(t, grf["time"], grf[column]) > CONTACT_N for t in times]
+
+
 def loading_response_knee(folder):
     """Each knee's largest flexion (deg, right and left) over the LOADING_RESPONSE of the
     stride after its foot's contact (the first node where grf.mot's vertical force exceeds
@@ -101,7 +107,7 @@ def loading_response_knee(folder):
                          ("knee_flexion_l", "ground_force_l_vy")):
         if coord not in q or force not in g:
             return None
-        on = [interp(t, g["time"], g[force]) > CONTACT_N for t in q["time"]]
+        on = foot_loaded(g, force, q["time"])
         n = len(on)
         starts = [k for k in range(n) if on[k] and not on[k - 1]]
         if not starts:
@@ -144,8 +150,7 @@ def phase_costs(folder):
         leg = power["_l" if muscle.endswith("_l") else ""]
         for k, v in enumerate(values):
             leg[k] += v
-    on = {side: [interp(x, g["time"], g[f"ground_force_{c}_vy"]) > CONTACT_N for x in t]
-          for side, c in (("", "r"), ("_l", "l"))}
+    on = {side: foot_loaded(g, f"ground_force_{c}_vy", t) for side, c in (("", "r"), ("_l", "l"))}
     phase = {"swing": [0.0] * len(t), "double": [0.0] * len(t), "single": [0.0] * len(t)}
     for side, other in (("", "_l"), ("_l", "")):
         for k in range(len(t)):

@@ -31,7 +31,9 @@ static const char* kBalanceUsage =
     "knee_adduction (the 6-DOF knee only; what its contact, ligaments and muscles supply\n"
     "together); over the stride: the frontal angular momentum about the\n"
     "centre of mass, lumbar_bending, the trunk's sway about the centre of mass, and the pelvis\n"
-    "residuals (zero for a dynamically consistent motion and load).\n\n"
+    "residuals (zero for a dynamically consistent motion and load): their RMS and, per axis,\n"
+    "their stride mean (what OpenSim's residual reduction answers by the model's mass and\n"
+    "the torso's centre of mass).\n\n"
     "  --rows   also a table of every loaded row of each foot: the centre of pressure in the\n"
     "           foot's frame (forward, lateral), the mediolateral ground force (+ lateral)\n"
     "           and, for a 6-DOF knee, the net moment about knee_adduction, the ground\n"
@@ -122,7 +124,8 @@ int gs_cmd_balance(int argc, char** argv) {
   }
   int speeds = gs_app_pose_kinematics(m, d, &t, &map, q, v, a);
   stat cop_hip[2] = {0}, cop_com[2] = {0}, abd[2] = {0}, mom[2] = {0}, ang = {0}, bend = {0},
-       sway = {0}, resf = {0}, resm = {0}, knee[2] = {{0}};
+       sway = {0}, resf = {0}, resm = {0}, knee[2] = {{0}}, resf_axis[3] = {{0}},
+       resm_axis[3] = {{0}};
   double weight = mj_getTotalmass(m) * mju_norm3(m->opt.gravity);
   gsBalance* all = rows ? (gsBalance*)malloc(sizeof(gsBalance) * (size_t)n) : NULL;
   int* loaded = rows ? (int*)malloc(sizeof(int) * (size_t)(2 * n)) : NULL;
@@ -158,6 +161,10 @@ int gs_cmd_balance(int argc, char** argv) {
     add(&sway, b.trunk_lateral);
     add(&resf, mju_norm3(b.residual_force));
     add(&resm, mju_norm3(b.residual_moment));
+    for (int k = 0; k < 3; k++) {
+      add(&resf_axis[k], b.residual_force[k]);
+      add(&resm_axis[k], b.residual_moment[k]);
+    }
   }
   printf("frontal-plane balance of %s with %s (%s, %d rows, %.3f-%.3f s; speeds %s)\n", pose,
          grf, path, n, t.time[0], t.time[n - 1],
@@ -183,6 +190,10 @@ int gs_cmd_balance(int argc, char** argv) {
   printf("trunk CoM sway about the whole-body CoM (range): %.1f cm\n", 100 * (sway.hi - sway.lo));
   printf("pelvis residuals, RMS: force %.1f N (%.3f BW), moment %.1f N m\n", rms(&resf),
          rms(&resf) / weight, rms(&resm));
+  printf("pelvis residuals, stride mean: force along pelvis_tx / _ty / _tz %.1f / %.1f / %.1f N, "
+         "moment about pelvis_rz / _rx / _ry %.1f / %.1f / %.1f N m\n", mean(&resf_axis[0]),
+         mean(&resf_axis[1]), mean(&resf_axis[2]), mean(&resm_axis[0]), mean(&resm_axis[1]),
+         mean(&resm_axis[2]));
   for (int s = 0; rows && s < 2; s++) {
     int has_knee = spec.knee_adduction[s] >= 0 && spec.ankle_joint[s] >= 0;
     double side = s == 0 ? -1.0 : 1.0;  // lateral: -y right, +y left

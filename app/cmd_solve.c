@@ -1317,6 +1317,12 @@ static int solve(gsTrackOptions o) {
     cJSON_AddNumberToObject(pj, "violation_before", rep.polish_viol_before);
     // the objective J of the point polished (what the polish costs: J there against "objective")
     cJSON_AddNumberToObject(pj, "objective_before", rep.polish_obj_before);
+    // the objective J of the polish's point (null where it was not less violated): a point more
+    // than GO_POLISH_MAX_RISE above objective_before is not used
+    if (isfinite(rep.polish_obj_after))
+      cJSON_AddNumberToObject(pj, "objective_after", rep.polish_obj_after);
+    else
+      cJSON_AddNullToObject(pj, "objective_after");
     cJSON_AddBoolToObject(pj, "used", rep.polished);
   }
   cJSON_AddNumberToObject(summary, "initial_violation", rep.initial_violation);

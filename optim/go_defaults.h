@@ -118,6 +118,12 @@
 // after a stop signal (s)
 #define GO_POLISH_ITER 200
 #define GO_STOP_POLISH_S 30
+// the polish's point is used only where its objective J lies at most this fraction above the
+// point polished (-): the nearest consistent point moves J by 0.05 % (tracking solves) to 2 %
+// (predictions), but a polish that hit its iteration limit in Ipopt's restoration phase once
+// returned a point at J 81.3 from J 2.053 (jw_bouncy7 on a model variant; docs/BENCHMARKS.md,
+// "The welded arms' pose and the pitch residual")
+#define GO_POLISH_MAX_RISE 0.10
 
 // goal weights of gaitsim track (go_gait_opts.w_*, -); go_gait_opts_default keeps its own
 // unit weights for library callers

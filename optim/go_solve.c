@@ -417,7 +417,7 @@ kept:
 // stage 5: the feasibility polish of *zout (Ipopt's point when converged and not settled, whose
 // acceptable test allows a violation of 1e-4, else the best iterate; go_gait_set_proximal), by
 // Gauss-Newton, whenever that point is violated by more than 1e-8; *zout becomes zb when the
-// polished point is less violated than *zout. 0 or -1 with err
+// polished point is less violated than *zout and go_solve_polish_usable. 0 or -1 with err
 static int polish(run_state* s, double** zout, go_solve_report* rep, char* err, int errsz) {
   const go_solve_plan* p = s->p;
   const go_solve_result* res = &rep->result;
@@ -433,10 +433,20 @@ static int polish(run_state* s, double** zout, go_solve_report* rep, char* err, 
     return -1;
   }
   if (s->z != *zout) memcpy(s->z, *zout, sizeof(double) * (size_t)s->n);
+  // the point polished, kept for when the polish's point is refused (Ipopt overwrites s->z),
+  // and a scaled copy of the polish's point for its objective
+  double* keep = (double*)malloc(sizeof(double) * (size_t)(2 * s->n));
+  if (!keep) {
+    go_gait_set_proximal(s->g, NULL);
+    snprintf(err, (size_t)errsz, "out of memory (polish)");
+    return -1;
+  }
+  memcpy(keep, *zout, sizeof(double) * (size_t)s->n);
   go_ipopt_opts po;
   char why[512];
   if (set_polish(&po, why, sizeof(why)) != 0) {
     go_gait_set_proximal(s->g, NULL);
+    free(keep);
     snprintf(err, (size_t)errsz, "polish: %s", why);
     return -1;
   }
@@ -455,18 +465,43 @@ static int polish(run_state* s, double** zout, go_solve_report* rep, char* err, 
   int prc = go_ipopt_solve(s->nlp, &po, s->z, s->zs, NULL, pres, why, sizeof(why));
   go_gait_set_proximal(s->g, NULL);
   if (prc != 0) {
+    free(keep);
     snprintf(err, (size_t)errsz, "polish: %s", why);
     return -1;
   }
   int pconv = solve_converged(pres);
   const double* zp = pconv || pres->best_iter < 0 ? s->z : s->zs;
   double vp = pconv || pres->best_iter < 0 ? pres->max_viol : pres->best_viol;
+  rep->polish_obj_after = NAN;
   if (vp < rep->polish_viol_before) {
-    memcpy(s->zb, zp, sizeof(double) * (size_t)s->n);
-    *zout = s->zb;
-    rep->polished = 1;
+    // its objective (the proximal term is off again): a point far above the one polished is
+    // not the nearest consistent one but where Ipopt wandered (e.g. in its restoration phase)
+    double* zps = keep + s->n;
+    double fp;
+    go_nlp_scale_z(s->nlp, zp, zps);
+    rep->polish_obj_after =
+        go_nlp_eval_f(s->nlp, zps, &fp) == 0 ? go_nlp_objective_phys(s->nlp, fp) : NAN;
+    if (go_solve_polish_usable(rep->polish_viol_before, rep->polish_obj_before, vp,
+                               rep->polish_obj_after)) {
+      memcpy(s->zb, zp, sizeof(double) * (size_t)s->n);
+      *zout = s->zb;
+      rep->polished = 1;
+    } else if (p->progress) {
+      fprintf(p->progress, "%s: polish: its point's objective %.6g is more than %.0f %% above "
+              "the point polished (%.6g): not used\n", p->label, rep->polish_obj_after,
+              100 * GO_POLISH_MAX_RISE, rep->polish_obj_before);
+    }
   }
+  // the point polished stays where the polish is not used (s->z held it and Ipopt moved it)
+  if (!rep->polished && *zout == s->z) memcpy(s->z, keep, sizeof(double) * (size_t)s->n);
+  free(keep);
   return 0;
+}
+
+int go_solve_polish_usable(double viol_before, double obj_before, double viol_after,
+                           double obj_after) {
+  return viol_after < viol_before &&
+         obj_after <= obj_before + GO_POLISH_MAX_RISE * fmax(fabs(obj_before), 1e-12);
 }
 
 // the stages of go_solve_run on the buffers of s; 0 or -1 with err

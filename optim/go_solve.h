@@ -19,7 +19,7 @@
 //      else (stopped short, or settled) the best iterate;
 //   5. feasibility polish: when that point is violated by more than 1e-8, the dynamically
 //      consistent point nearest to it (go_gait_set_proximal, Gauss-Newton Hessian), used when
-//      its violation is lower.
+//      its violation is lower and its objective at most GO_POLISH_MAX_RISE above the point's.
 // Progress (one line per Ipopt iteration, one per stage, the largest violation and multiplier
 // per constraint block) goes to plan.progress, each stage line prefixed with plan.label.
 // A further stage in front of the main solve adds its settings to go_solve_plan and its figures
@@ -136,6 +136,8 @@ typedef struct {
   go_solve_result polish;     // the polish solve (polish_run)
   double polish_viol_before;  // max scaled violation of the point polished (-)
   double polish_obj_before;   // physical objective J of the point polished (-)
+  double polish_obj_after;    // physical objective J of the polish's point (-; NAN: not
+                              // evaluated, the polish being no less violated)
   int best_iterate_written;   // 1: z is a best iterate or its polish, not Ipopt's final point
   double* z;                  // the point chosen (n, physical; owned)
   double initial_violation;   // max scaled violation at z0 (-)
@@ -157,6 +159,12 @@ void go_solve_plan_default(go_solve_plan* plan);
 // level asks the same change (acceptable_obj_change_tol rel; extra options the caller adds
 // later still override it). gaitsim predict: GO_PREDICT_SETTLE_VIOL, GO_PREDICT_SETTLE_REL.
 void go_solve_plan_settle_main(go_solve_plan* plan, double viol, double rel);
+
+// 1 when the feasibility polish's point (violation viol_after, objective obj_after) replaces
+// the point polished (viol_before, obj_before): less violated, and its objective J at most
+// GO_POLISH_MAX_RISE (relative) above; 0 otherwise, and for a NaN objective.
+int go_solve_polish_usable(double viol_before, double obj_before, double viol_after,
+                           double obj_after);
 
 // Run the plan. 0 with *report filled (the solve's outcome is report->result.status), or -1
 // with the reason in err (a solve could not start, out of memory); report->z is then NULL.

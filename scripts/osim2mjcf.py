@@ -55,7 +55,9 @@ KNEE_SECONDARY = {
     "knee_tz": (1.0e6, 2.0e3),
 }
 
-# locked coordinates of the welded arms: arms down, elbows 15 deg flexed (rad)
+# locked coordinates of the welded arms (`--arm-pose hanging`, the default): arms down, elbows 15
+# deg flexed (rad); `--arm-pose trial` welds them at the trial stride's mean instead
+# (trial_arm_pose; docs/BENCHMARKS.md, "The welded arms' pose and the pitch residual")
 ARM_POSE = {
     "arm_flex_r": 0.0, "arm_add_r": 0.0, "arm_rot_r": 0.0, "elbow_flex_r": math.radians(15.0),
     "wrist_flex_r": 0.0, "wrist_dev_r": 0.0,
@@ -502,6 +504,7 @@ class OsimModel:
                 "rotations": [a for a in axes if a["kind"] == "rotation"],
                 "translations": [a for a in axes if a["kind"] == "translation"],
             })
+        self.arm_pose = dict(ARM_POSE)  # main() replaces it for --arm-pose trial
         self.couplers = {}
         for c in model.find("ConstraintSet/objects"):
             if c.tag == "CoordinateCouplerConstraint" and c.findtext("isEnforced").strip() == "true":
@@ -581,8 +584,8 @@ class OsimModel:
         for name in self.coords:
             if name in independent:
                 values[name] = independent[name]
-            elif name in ARM_POSE:
-                values[name] = ARM_POSE[name]
+            elif name in self.arm_pose:
+                values[name] = self.arm_pose[name]
             else:
                 values[name] = self.default_value(name)
         for dep, (indep, fn, scale) in self.couplers.items():
@@ -1479,6 +1482,28 @@ def read_trial(path):
             pose[c] = v if c in TRANSLATIONS else math.radians(v)
         frames.append((rec["time"], pose))
     return frames
+
+
+def trial_arm_pose(path, start, end):
+    """The welded arms' coordinates (ARM_POSE's names, rad) as the mean of the IK csv's columns
+    (degrees) over its rows with start <= time <= end (s, source time): one stride of the trial,
+    so the arms' mass sits where the subject carried it on average (JW's og5 stride: shoulders
+    flexed about 20 deg, abducted 21-27 deg, rotated 74-87 deg, elbows 25 deg) instead of
+    hanging."""
+    with open(path) as f:
+        rows = [r for r in csv.reader(line for line in f if not line.startswith("#"))]
+    header = rows[0]
+    missing = [c for c in ARM_POSE if c not in header]
+    if missing:
+        raise SystemExit("osim2mjcf: %s: no column %s (needed by --arm-pose trial)"
+                         % (path, missing[0]))
+    t = header.index("time")
+    stride = [r for r in rows[1:] if start <= float(r[t]) <= end]
+    if len(stride) < 2:
+        raise SystemExit("osim2mjcf: %s: fewer than 2 rows within %.4f-%.4f s"
+                         % (path, start, end))
+    return {c: math.radians(sum(float(r[header.index(c)]) for r in stride) / len(stride))
+            for c in ARM_POSE}
 
 
 def reference_poses(frames):
@@ -2548,6 +2573,13 @@ class Converter:
         out.append("    Res 36:498).")
         out.append("  %d DOF (hinge/slide only), %d muscles, total mass %s kg." % (
             len(MODEL_COORDINATES), len(m.muscles), fmt(total_mass, 6)))
+        if m.arm_pose != ARM_POSE:
+            out.append("  Arms welded at the trial stride's mean arm coordinates "
+                       "(--arm-pose trial):")
+            for side in ("_r", "_l"):
+                out.append("    " + ", ".join("%s %.1f" % (c, math.degrees(v))
+                                              for c, v in m.arm_pose.items()
+                                              if c.endswith(side) and "wrist" not in c) + " deg")
         out.append("  Frames: body 'ground' rotates OpenSim's Y-up ground (X forward, Y up, Z right)")
         out.append("    into MuJoCo's Z-up world (+90 deg about X): OpenSim Y -> world Z,")
         out.append("    OpenSim Z -> world -Y. Coordinate values mean what they mean in OpenSim.")
@@ -2772,6 +2804,10 @@ def main():
         os.path.dirname(os.path.abspath(__file__)), "..", "mjmodels", "reference",
         "jw_wrap_fit.json"), help="the fitted wrap geoms of scripts/fit_wraps.py ('none': the "
                                   "converter's own surrogates only)")
+    ap.add_argument("--arm-pose", choices=("hanging", "trial"), default="hanging",
+                    help="where the welded arms sit: 'hanging' (arms down, elbows 15 deg; the "
+                         "default) or 'trial' (the mean of the --trial-ik arm columns over the "
+                         "stride between the first two right heel strikes of --trial-events)")
     args = ap.parse_args()
     wrap_fit = {}
     if args.wrap_fit != "none":
@@ -2786,6 +2822,13 @@ def main():
     trial = args.trial_ik or os.path.join(os.path.dirname(os.path.abspath(args.osim)), "..",
                                           "ngait_og5", "IK_ngait_og5.csv")
     model = OsimModel(args.osim)
+    if args.arm_pose == "trial":
+        if len(heel_strikes["r"]) < 2:
+            ap.error("--arm-pose trial: %s names fewer than two right heel strikes"
+                     % args.trial_events)
+        model.arm_pose = trial_arm_pose(trial, heel_strikes["r"][0], heel_strikes["r"][1])
+        print("arms welded at the trial stride's mean: " + ", ".join(
+            "%s %.1f deg" % (c, math.degrees(v)) for c, v in model.arm_pose.items()))
     frames = read_trial(trial)
     metabolic = read_metabolic(os.path.join(args.muscle_params,
                                             "MTparameters_subject1_with_metabolic_params.csv"))

@@ -1317,8 +1317,9 @@ static int solve(gsTrackOptions o) {
     cJSON_AddNumberToObject(pj, "violation_before", rep.polish_viol_before);
     // the objective J of the point polished (what the polish costs: J there against "objective")
     cJSON_AddNumberToObject(pj, "objective_before", rep.polish_obj_before);
-    // the objective J of the polish's point (null where it was not less violated): a point more
-    // than GO_POLISH_MAX_RISE above objective_before is not used
+    // the objective J of the polish's point (null where it was not less violated): from a point
+    // within GO_POLISH_GUARD_VIOL of feasibility, one more than GO_POLISH_MAX_RISE above
+    // objective_before is not used
     if (isfinite(rep.polish_obj_after))
       cJSON_AddNumberToObject(pj, "objective_after", rep.polish_obj_after);
     else

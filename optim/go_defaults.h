@@ -118,11 +118,15 @@
 // after a stop signal (s)
 #define GO_POLISH_ITER 200
 #define GO_STOP_POLISH_S 30
-// the polish's point is used only where its objective J lies at most this fraction above the
-// point polished (-): the nearest consistent point moves J by 0.05 % (tracking solves) to 2 %
-// (predictions), but a polish that hit its iteration limit in Ipopt's restoration phase once
-// returned a point at J 81.3 from J 2.053 (jw_bouncy7 on a model variant; docs/BENCHMARKS.md,
-// "The welded arms' pose and the pitch residual")
+// from a point polished at a violation of at most GO_POLISH_GUARD_VIOL (-; a solve's answer: the
+// refinement and the predictions stop at 1e-3 or below), the polish's point is used only where
+// its objective J lies at most GO_POLISH_MAX_RISE (-) above the point's: the nearest consistent
+// point moves J by 0.05 % (80-node tracking solves) to 2 % (predictions), but a polish that hit
+// its iteration limit in Ipopt's restoration phase once returned a point at J 81.3 from J 2.053
+// (jw_bouncy7 on a model variant; docs/BENCHMARKS.md, "The welded arms' pose and the pitch
+// residual"). From farther (a solve stopped by a signal mid-way: violations 0.03-0.6 in
+// cli_bad_inputs' planar solve) the projection moves J by 10-35 % and is used as before.
+#define GO_POLISH_GUARD_VIOL 1e-2
 #define GO_POLISH_MAX_RISE 0.10
 
 // goal weights of gaitsim track (go_gait_opts.w_*, -); go_gait_opts_default keeps its own

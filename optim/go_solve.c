@@ -501,7 +501,8 @@ static int polish(run_state* s, double** zout, go_solve_report* rep, char* err, 
 int go_solve_polish_usable(double viol_before, double obj_before, double viol_after,
                            double obj_after) {
   return viol_after < viol_before &&
-         obj_after <= obj_before + GO_POLISH_MAX_RISE * fmax(fabs(obj_before), 1e-12);
+         (viol_before > GO_POLISH_GUARD_VIOL ||
+          obj_after <= obj_before + GO_POLISH_MAX_RISE * fmax(fabs(obj_before), 1e-12));
 }
 
 // the stages of go_solve_run on the buffers of s; 0 or -1 with err

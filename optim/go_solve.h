@@ -19,7 +19,8 @@
 //      else (stopped short, or settled) the best iterate;
 //   5. feasibility polish: when that point is violated by more than 1e-8, the dynamically
 //      consistent point nearest to it (go_gait_set_proximal, Gauss-Newton Hessian), used when
-//      its violation is lower and its objective at most GO_POLISH_MAX_RISE above the point's.
+//      its violation is lower and, from a nearly feasible point, its objective at most
+//      GO_POLISH_MAX_RISE above the point's (go_solve_polish_usable).
 // Progress (one line per Ipopt iteration, one per stage, the largest violation and multiplier
 // per constraint block) goes to plan.progress, each stage line prefixed with plan.label.
 // A further stage in front of the main solve adds its settings to go_solve_plan and its figures
@@ -161,8 +162,9 @@ void go_solve_plan_default(go_solve_plan* plan);
 void go_solve_plan_settle_main(go_solve_plan* plan, double viol, double rel);
 
 // 1 when the feasibility polish's point (violation viol_after, objective obj_after) replaces
-// the point polished (viol_before, obj_before): less violated, and its objective J at most
-// GO_POLISH_MAX_RISE (relative) above; 0 otherwise, and for a NaN objective.
+// the point polished (viol_before, obj_before): less violated, and, where viol_before <=
+// GO_POLISH_GUARD_VIOL, its objective J at most GO_POLISH_MAX_RISE (relative) above (a NaN
+// objective fails that test); 0 otherwise.
 int go_solve_polish_usable(double viol_before, double obj_before, double viol_after,
                            double obj_after);
 

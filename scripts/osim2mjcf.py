@@ -1469,12 +1469,17 @@ def read_heel_strikes(path):
     return {"r": as_list(right), "l": as_list(left)}
 
 
-def read_trial(path):
+def read_ik_rows(path):
+    """(column labels, rows of strings) of an IK csv, its '#' comment lines left out."""
     with open(path) as f:
         rows = [r for r in csv.reader(line for line in f if not line.startswith("#"))]
-    header = rows[0]
+    return rows[0], rows[1:]
+
+
+def read_trial(path):
+    header, rows = read_ik_rows(path)
     frames = []
-    for r in rows[1:]:
+    for r in rows:
         rec = dict(zip(header, (float(v) for v in r)))
         pose = {}
         for c in MODEL_COORDINATES:
@@ -1490,20 +1495,19 @@ def trial_arm_pose(path, start, end):
     so the arms' mass sits where the subject carried it on average (JW's og5 stride: shoulders
     flexed about 20 deg, abducted 21-27 deg, rotated 74-87 deg, elbows 25 deg) instead of
     hanging."""
-    with open(path) as f:
-        rows = [r for r in csv.reader(line for line in f if not line.startswith("#"))]
-    header = rows[0]
+    header, rows = read_ik_rows(path)
     missing = [c for c in ARM_POSE if c not in header]
     if missing:
         raise SystemExit("osim2mjcf: %s: no column %s (needed by --arm-pose trial)"
                          % (path, missing[0]))
     t = header.index("time")
-    stride = [r for r in rows[1:] if start <= float(r[t]) <= end]
+    stride = [r for r in rows if start <= float(r[t]) <= end]
     if len(stride) < 2:
         raise SystemExit("osim2mjcf: %s: fewer than 2 rows within %.4f-%.4f s"
                          % (path, start, end))
-    return {c: math.radians(sum(float(r[header.index(c)]) for r in stride) / len(stride))
-            for c in ARM_POSE}
+    column = {c: header.index(c) for c in ARM_POSE}
+    return {c: math.radians(sum(float(r[j]) for r in stride) / len(stride))
+            for c, j in column.items()}
 
 
 def reference_poses(frames):

@@ -414,6 +414,14 @@ kept:
   return 0;
 }
 
+// the physical objective J at the physical point z (NAN where it cannot be evaluated); zs
+// (n) receives z scaled
+static double objective_at(go_nlp* nlp, const double* z, double* zs) {
+  double f;
+  go_nlp_scale_z(nlp, z, zs);
+  return go_nlp_eval_f(nlp, zs, &f) == 0 ? go_nlp_objective_phys(nlp, f) : NAN;
+}
+
 // stage 5: the feasibility polish of *zout (Ipopt's point when converged and not settled, whose
 // acceptable test allows a violation of 1e-4, else the best iterate; go_gait_set_proximal), by
 // Gauss-Newton, whenever that point is violated by more than 1e-8; *zout becomes zb when the
@@ -476,11 +484,7 @@ static int polish(run_state* s, double** zout, go_solve_report* rep, char* err, 
   if (vp < rep->polish_viol_before) {
     // its objective (the proximal term is off again): a point far above the one polished is
     // not the nearest consistent one but where Ipopt wandered (e.g. in its restoration phase)
-    double* zps = keep + s->n;
-    double fp;
-    go_nlp_scale_z(s->nlp, zp, zps);
-    rep->polish_obj_after =
-        go_nlp_eval_f(s->nlp, zps, &fp) == 0 ? go_nlp_objective_phys(s->nlp, fp) : NAN;
+    rep->polish_obj_after = objective_at(s->nlp, zp, keep + s->n);
     if (go_solve_polish_usable(rep->polish_viol_before, rep->polish_obj_before, vp,
                                rep->polish_obj_after)) {
       memcpy(s->zb, zp, sizeof(double) * (size_t)s->n);
@@ -567,10 +571,7 @@ static int run_stages(run_state* s, go_solve_report* rep, char* err, int errsz) 
   rep->best_iterate_written = zout == s->zb;
   memcpy(rep->z, zout, sizeof(double) * (size_t)s->n);
   // its objective, violation and largest defect
-  go_nlp_scale_z(s->nlp, zout, s->zs);
-  double fout;
-  rep->objective =
-      go_nlp_eval_f(s->nlp, s->zs, &fout) == 0 ? go_nlp_objective_phys(s->nlp, fout) : NAN;
+  rep->objective = objective_at(s->nlp, zout, s->zs);
   rep->max_violation =
       go_nlp_eval_g(s->nlp, s->zs, s->gv) == 0 ? go_nlp_violation(s->nlp, s->gv) : INFINITY;
   if (f) print_blocks(f, s->g, s->gv, p->label, "final");

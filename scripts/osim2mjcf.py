@@ -45,7 +45,8 @@ MODEL_COORDINATES = [
 # the coordinates in m (the others in rad; the trial's IK in degrees)
 TRANSLATIONS = ("pelvis_tx", "pelvis_ty", "pelvis_tz", "knee_tx", "knee_ty", "knee_tz")
 
-# secondary right-knee coordinates: placeholder springs until a knee-contact model replaces them
+# secondary right-knee coordinates: placeholder springs and damping until a knee-contact model
+# replaces them (--knee-params removes both: add_knee_params)
 KNEE_SECONDARY = {
     # name: (stiffness N m/rad or N/m, damping N m s/rad or N s/m)
     "knee_adduction": (1.0e4, 50.0),
@@ -55,8 +56,8 @@ KNEE_SECONDARY = {
     "knee_tz": (1.0e6, 2.0e3),
 }
 
-# locked coordinates of the welded arms (`--arm-pose hanging`, the default): arms down, elbows 15
-# deg flexed (rad); `--arm-pose trial` welds them at the trial stride's mean instead
+# locked coordinates of the welded arms with `--arm-pose hanging`: arms down, elbows 15 deg flexed
+# (rad); `--arm-pose trial`, the default, welds them at the trial stride's mean instead
 # (trial_arm_pose; docs/BENCHMARKS.md, "The welded arms' pose and the pitch residual")
 ARM_POSE = {
     "arm_flex_r": 0.0, "arm_add_r": 0.0, "arm_rot_r": 0.0, "elbow_flex_r": math.radians(15.0),
@@ -1498,7 +1499,8 @@ def trial_arm_pose(path, start, end):
     header, rows = read_ik_rows(path)
     missing = [c for c in ARM_POSE if c not in header]
     if missing:
-        raise SystemExit("osim2mjcf: %s: no column %s (needed by --arm-pose trial)"
+        raise SystemExit("osim2mjcf: %s: no column %s (needed by --arm-pose trial, the default; "
+                         "--arm-pose hanging needs none)"
                          % (path, missing[0]))
     t = header.index("time")
     stride = [r for r in rows if start <= float(r[t]) <= end]
@@ -2579,7 +2581,7 @@ class Converter:
             len(MODEL_COORDINATES), len(m.muscles), fmt(total_mass, 6)))
         if m.arm_pose != ARM_POSE:
             out.append("  Arms welded at the trial stride's mean arm coordinates "
-                       "(--arm-pose trial):")
+                       "(arm pose 'trial'):")
             for side in ("_r", "_l"):
                 out.append("    " + ", ".join("%s %.1f" % (c, math.degrees(v))
                                               for c, v in m.arm_pose.items()
@@ -2764,8 +2766,13 @@ def write_reference(model, frames, path, poses_path, osim_name, trial_name, meth
 def add_knee_params(xml_path, params_path):
     """--knee-params: insert the gs_knee <custom> numerics of mjmodels/knee/jw_knee.json
     (scripts/prepare_knee.py knee_custom_snippet) into the written model and remove the right
-    knee's placeholder springs (stiffness/springref of knee_rotation, knee_adduction, knee_tx,
-    knee_ty, knee_tz; their damping stays). Rewrites xml_path atomically."""
+    knee's placeholders on knee_rotation, knee_adduction, knee_tx, knee_ty, knee_tz: their springs
+    (stiffness/springref) and their joint damping (KNEE_SECONDARY). The implant's contact and the
+    ligaments (with the ligaments' own damping) then hold the five coordinates, as in the .osim,
+    whose coordinates carry no damping; the placeholders' 50 N m s/rad and 2000 N s/m had no
+    tissue behind them and carried, in stance, up to 14 N m of the knee's frontal moment and 230
+    N of its anterior shear in a tracking solution (docs/BENCHMARKS.md, "The knee's placeholder
+    damping"). Rewrites xml_path atomically."""
     import json
     import re
     from prepare_knee import knee_custom_snippet
@@ -2774,11 +2781,11 @@ def add_knee_params(xml_path, params_path):
     with open(xml_path, encoding="utf-8") as f:
         text = f.read()
     for name in ("knee_rotation", "knee_adduction", "knee_tx", "knee_ty", "knee_tz"):
-        text, n = re.subn(r'(<joint name="%s"[^>]*?) stiffness="[^"]*" springref="[^"]*"' % name,
-                          r"\1", text)
+        text, n = re.subn(r'(<joint name="%s"[^>]*?) stiffness="[^"]*" springref="[^"]*" '
+                          r'damping="[^"]*"' % name, r"\1", text)
         if n != 1:
-            raise SystemExit("osim2mjcf.py: %s: joint %s placeholder spring not found" % (
-                xml_path, name))
+            raise SystemExit("osim2mjcf.py: %s: joint %s placeholder spring and damping not "
+                             "found" % (xml_path, name))
     if "</mujoco>" not in text:
         raise SystemExit("osim2mjcf.py: %s: no </mujoco>" % xml_path)
     text = text.replace("</mujoco>", knee_custom_snippet(params) + "</mujoco>", 1)
@@ -2808,10 +2815,10 @@ def main():
         os.path.dirname(os.path.abspath(__file__)), "..", "mjmodels", "reference",
         "jw_wrap_fit.json"), help="the fitted wrap geoms of scripts/fit_wraps.py ('none': the "
                                   "converter's own surrogates only)")
-    ap.add_argument("--arm-pose", choices=("hanging", "trial"), default="hanging",
-                    help="where the welded arms sit: 'hanging' (arms down, elbows 15 deg; the "
-                         "default) or 'trial' (the mean of the --trial-ik arm columns over the "
-                         "stride between the first two right heel strikes of --trial-events)")
+    ap.add_argument("--arm-pose", choices=("hanging", "trial"), default="trial",
+                    help="where the welded arms sit: 'trial' (the default: the mean of the "
+                         "--trial-ik arm columns over the stride between the first two right "
+                         "heel strikes of --trial-events) or 'hanging' (arms down, elbows 15 deg)")
     args = ap.parse_args()
     wrap_fit = {}
     if args.wrap_fit != "none":

@@ -2,8 +2,10 @@
 //
 // The pose: jw_fullbody_knee6.xml where eq. 3's band x 1.5 stopped the 1.0 m/s prediction (an
 // iterate of `gaitsim predict --guess results/track --speed 1.0 --band-scale 1.5`): adductor
-// longus's segment from pelvis to femur passes 1.6e-11 m inside its femoral-shaft cylinder
-// (AL_at_femshaft, radius 20.9 mm). Checks:
+// longus's segment from pelvis to femur passes within about 1e-11 m of its femoral-shaft cylinder
+// (AL_at_femshaft, radius 20.9 mm). The graze itself is found by stepping hip adduction from
+// there by 1e-11 rad (at most 1000 steps either way) to the first pose where MuJoCo's length is
+// NaN: the model's rounding (a regenerated model's body frames) moves it by a few steps. Checks:
 //  - MuJoCo 2.2.2 alone fails there: a NaN length (the defect this module is for; should a MuJoCo
 //    release fix it, this check says so and the module can go);
 //  - gs_fwd_position: the length is the straight site-to-site distance (the path at a graze)
@@ -33,6 +35,7 @@
 #define TOL_SECOND 1e-10     // second difference of the repaired length across the graze (m)
 #define FAR_SIDE 5e-3        // MuJoCo's far-side path: this much longer, or more          (m)
 #define FD_STEP 1e-6         // central-difference step of the moment-arm check          (rad)
+#define GRAZE_STEP 1e-11     // hip adduction step of the search for the graze           (rad)
 
 // qpos of the grazing pose, in the model's joint order (pelvis_tx ... lumbar_rotation)
 static const double kGrazePose[26] = {
@@ -72,11 +75,22 @@ int main(void) {
   EXPECT_TRUE(t >= 0 && add >= 0);
   EXPECT_EQ_INT(3, m->tendon_num[t]);  // site, cylinder, site
 
+  // the graze: the nearest pose to kGrazePose along hip adduction where MuJoCo's length is NaN
+  double g = NAN;
+  for (int k = 0; k <= 2000 && isnan(g); k++) {
+    double dq = (k % 2 ? 1 : -1) * ((k + 1) / 2) * GRAZE_STEP;
+    set_pose(m, raw, add, dq);
+    mj_fwdPosition(m, raw);
+    if (!isfinite(raw->ten_length[t])) g = dq;
+  }
+  EXPECT_TRUE(!isnan(g));
+  if (isnan(g)) return GS_TEST_RESULT();
+
   // MuJoCo alone, and the repair, at the graze
-  set_pose(m, raw, add, 0);
+  set_pose(m, raw, add, g);
   mj_fwdPosition(m, raw);
   EXPECT_TRUE(!isfinite(raw->ten_length[t]));
-  set_pose(m, d, add, 0);
+  set_pose(m, d, add, g);
   EXPECT_EQ_INT(1, gs_fwd_position(m, d));
   EXPECT_NEAR(straight_length(m, d, t), d->ten_length[t], TOL_GRAZE_LEN);
   EXPECT_NEAR(d->ten_length[t], d->actuator_length[t], 0);  // transmission redone
@@ -88,10 +102,10 @@ int main(void) {
   }
   EXPECT_TRUE(same);
   double arm = d->ten_J[t * m->nv + add], lp, lm;
-  set_pose(m, d, add, FD_STEP);
+  set_pose(m, d, add, g + FD_STEP);
   gs_fwd_position(m, d);
   lp = d->ten_length[t];
-  set_pose(m, d, add, -FD_STEP);
+  set_pose(m, d, add, g - FD_STEP);
   gs_fwd_position(m, d);
   lm = d->ten_length[t];
   EXPECT_NEAR((lp - lm) / (2 * FD_STEP), arm, TOL_ARM);
@@ -99,12 +113,12 @@ int main(void) {
   // gs_forward at the graze: the repaired tendon of gs_fwd_position, and accelerations finite
   // where mj_forward's are not
   double repaired_len = 0;
-  set_pose(m, d, add, 0);
+  set_pose(m, d, add, g);
   gs_fwd_position(m, d);
   repaired_len = d->ten_length[t];
-  set_pose(m, raw, add, 0);
+  set_pose(m, raw, add, g);
   mj_forward(m, raw);
-  set_pose(m, d, add, 0);
+  set_pose(m, d, add, g);
   EXPECT_EQ_INT(1, gs_forward(m, d));
   EXPECT_TRUE(d->ten_length[t] == repaired_len);
   int raw_finite = 1, finite = 1;
@@ -115,9 +129,9 @@ int main(void) {
   EXPECT_TRUE(!raw_finite);
   EXPECT_TRUE(finite);
   // gs_inverse at the graze: the same repaired tendon, and the actuator's length from it
-  set_pose(m, raw, add, 0);
+  set_pose(m, raw, add, g);
   mj_inverse(m, raw);
-  set_pose(m, d, add, 0);
+  set_pose(m, d, add, g);
   EXPECT_EQ_INT(1, gs_inverse(m, d));
   EXPECT_TRUE(!isfinite(raw->actuator_length[t]));
   EXPECT_TRUE(d->ten_length[t] == repaired_len && d->actuator_length[t] == repaired_len);
@@ -128,9 +142,9 @@ int main(void) {
     int raw_bad = 0, bad = 0, repaired = 0;
     double L[3] = {0, 0, 0}, worst = 0;
     for (int k = -1000; k <= 1000; k++) {
-      set_pose(m, raw, add, k * steps[s]);
+      set_pose(m, raw, add, g + k * steps[s]);
       mj_fwdPosition(m, raw);
-      set_pose(m, d, add, k * steps[s]);
+      set_pose(m, d, add, g + k * steps[s]);
       repaired += gs_fwd_position(m, d) > 0;
       double straight = straight_length(m, d, t);
       raw_bad += !isfinite(raw->ten_length[t]) || raw->ten_length[t] > straight + FAR_SIDE;

@@ -10,8 +10,9 @@
 // (b) the energy theorem at one state (the body lowered 1 cm into the floor, every dof moving,
 //     every muscle at activation 0.2): d/dt (KE + PE) by central differences along the state's
 //     own motion equals the budget's total within 1e-6 of the sum of the sources' magnitudes,
-//     and the foot contact, the knee and MuJoCo's joint damping each work more than that
-//     tolerance, so leaving any out fails the check; the feet's friction takes energy (< 0) and
+//     and the foot contact, the knee and MuJoCo's joint damping (50 N m s/rad put on
+//     knee_adduction and knee_rotation here: the shipped model has none) each work more than
+//     that tolerance, so leaving any out fails the check; the feet's friction takes energy (< 0) and
 //     with their normal forces' power makes up the feet's (1e-9).
 #include <math.h>
 #include <stdio.h>
@@ -81,7 +82,14 @@ int main(void) {
 
   // (b) the energy theorem at one state: d/dt (KE + PE) by central differences along the
   // state's own motion (q +- eps qdot, qdot +- eps qdd, with qdd from mj_forward) against the
-  // budget's total. Velocities on every dof so that every source works; the feet pressed in.
+  // budget's total. Velocities on every dof so that every source works; the feet pressed in;
+  // MuJoCo's joint damping on two knee dofs, so that its power is a source too.
+  const char* damped[] = {"knee_adduction", "knee_rotation"};
+  for (int k = 0; k < 2; k++) {
+    int j = mj_name2id(m, mjOBJ_JOINT, damped[k]);
+    EXPECT_TRUE(j >= 0);
+    if (j >= 0) m->dof_damping[m->jnt_dofadr[j]] = 50.0;
+  }
   mj_resetDataKeyframe(m, d, key >= 0 ? key : 0);
   mj_kinematics(m, d);
   int vertical = 0;  // the pelvis translation whose world axis is the most nearly vertical

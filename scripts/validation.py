@@ -169,13 +169,19 @@ def cost_across_speeds(sums):
     if 1.2 in by and 2.0 in by:
         row(["net CoT 2.0 against 1.2 m/s (J/(kg m))", f"{fmt(by[2.0])} against {fmt(by[1.2])}",
              "2.0 higher", ("yes" if by[2.0] > by[1.2] else "no") + caveat])
-    u_shape = 0 < kmin < len(v) - 1 and 1.0 <= v[kmin] <= 1.6
+    # U-shaped: falling at every step down to the minimum, rising at every step after it
+    breaks = [f"{fmt(v[k + 1], 1)} above {fmt(v[k], 1)}" for k in range(kmin)
+              if gross_cot[k + 1] >= gross_cot[k]] + \
+             [f"{fmt(v[k + 1], 1)} below {fmt(v[k], 1)}" for k in range(kmin, len(v) - 1)
+              if gross_cot[k + 1] <= gross_cot[k]]
+    u_shape = 0 < kmin < len(v) - 1 and 1.0 <= v[kmin] <= 1.6 and not breaks
+    not_u = f"; not U-shaped: {', '.join(breaks)}" if breaks else ""
     row(["gross CoT by speed (J/(kg m)); Ralston's",
          ", ".join(f"{fmt(x, 1)}: {fmt(g)}" for x, g in zip(v, gross_cot)) +
          "; " + ", ".join(f"{fmt(x, 1)}: {fmt(r)}" for x, r in zip(v, ral_cot)),
          "U-shaped, minimum at 1.0-1.6 m/s",
          ("yes" if u_shape else "no") + caveat + f" (model's minimum at {fmt(v[kmin], 1)} m/s, "
-         f"Ralston's at {fmt(v[kral], 1)})"])
+         f"Ralston's at {fmt(v[kral], 1)}{not_u})"])
     eff = [(s["speed_target_mps"], s["muscle_efficiency"]) for s in sums
            if s.get("speed_target_mps") and s.get("muscle_efficiency") is not None]
     if eff:
@@ -200,7 +206,9 @@ def cost_across_speeds(sums):
         print(f"The model's gross power in Ralston's form, least squares over {len(v)} speeds: "
               f"{a:.2f} + {b:.2f} v^2 W/kg (v in m/s), Ralston's {a_r:.2f} + {b_r:.2f} v^2: the "
               "first term is the cost per second whatever the speed, the second the cost that "
-              "grows with speed.\n")
+              "grows with speed. On the fitted curve the gross cost of transport a / v + b v is "
+              + (f"lowest at sqrt(a / b) = {math.sqrt(a / b):.2f} m/s" if a > 0 and b > 0 else
+                 "not U-shaped") + f", Ralston's at {math.sqrt(a_r / b_r):.2f} m/s.\n")
 
 
 def predictions(folders):

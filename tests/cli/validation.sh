@@ -9,8 +9,10 @@
 # (net + 1.2) / v 4.00, 3.20, 4.10 J/(kg m), lowest at 1.2 m/s: U-shaped, each check marked
 # provisional since 1.0, 1.4, 1.6 and 1.8 m/s are missing; gross power 3.20,
 # 3.84, 8.20 W/kg in Ralston's form a + b v^2 by least squares: 1.96 + 1.54 v^2, Ralston's
-# 29 cal/(kg min) = 2.02 W/kg + 0.0053 x 3600 cal/(kg min) = 1.33 W/kg per (m/s)^2); a speed whose
-# summary.json says converged false is named as stopped short; with --gaitsim a stand-in binary's
+# 29 cal/(kg min) = 2.02 W/kg + 0.0053 x 3600 cal/(kg min) = 1.33 W/kg per (m/s)^2, the fitted
+# gross cost of transport lowest at sqrt(a / b): 1.13 and 1.23 m/s); a speed whose
+# summary.json says converged false is named as stopped short; a fourth speed (1.6 m/s) whose gross
+# cost lies above 2.0 m/s's is marked not U-shaped; with --gaitsim a stand-in binary's
 # `work` table gives each solution's foot contact per collision (-15.0 / +2.0 J) and the right
 # leg's knee share of the stance negative work (0.30) and ankle share of the positive (0.59), no
 # left leg ("-"), its `work --grf` the measured trial's row first (0.50 / 0.50), and the two
@@ -65,6 +67,8 @@ check "net power rises" grep -qF "| net power by speed (W/kg) | 0.8: 2.00, 1.2: 
 check "CoT 2.0 above 1.2" grep -qF "| net CoT 2.0 against 1.2 m/s (J/(kg m)) | 3.50 against 2.20 | 2.0 higher | yes (provisional) |" <<<"$out"
 check "three of the sweep's seven speeds: provisional" grep -qF "Provisional: not solved: 1.0, 1.4, 1.6, 1.8 m/s, so the checks hold for the speeds shown only." <<<"$out"
 check "Ralston's form" grep -qF "3 speeds: 1.96 + 1.54 v^2 W/kg (v in m/s), Ralston's 2.02 + 1.33 v^2" <<<"$out"
+# the fitted curve's lowest gross cost of transport: sqrt(1.96 / 1.54), Ralston's sqrt(2.02 / 1.33)
+check "fitted minimum" grep -qF "a / v + b v is lowest at sqrt(a / b) = 1.13 m/s, Ralston's at 1.23 m/s." <<<"$out"
 check "gross CoT U-shaped" grep -qF "0.8: 4.00, 1.2: 3.20, 2.0: 4.10; 0.8: 3.59, 1.2: 3.28, 2.0: 3.67 | U-shaped, minimum at 1.0-1.6 m/s | yes (provisional) (model's minimum at 1.2 m/s, Ralston's at 1.2) |" <<<"$out"
 
 check "muscle efficiency by speed" grep -qF "| 0.8: 0.15, 1.2: 0.20, 2.0: 0.27 | about 0.25 (human muscle, Margaria 1968; a reference, not a target) | - |" <<<"$out"
@@ -125,6 +129,20 @@ err=$(/usr/bin/python3 "$src/scripts/validation.py" results --gaitsim ./no_such_
 status=$?
 check "--gaitsim missing: exit 1 (got $status), one line naming it" \
   test "$status" -eq 1 -a "$err" = "validation: trial: gaitsim cannot run (No such file or directory)"
+
+# a fourth speed that breaks the U: 1.6 m/s at a net 3.45 J/(kg m), gross (5.52 + 1.2) / 1.6 =
+# 4.20 J/(kg m), above 2.0 m/s's 4.10: the minimum stays at 1.2 m/s, the curve is not a U
+/usr/bin/python3 - <<'PY'
+import json, os
+os.makedirs("results/sweep/predict_1.6")
+json.dump({"problem": "prediction", "speed_target_mps": 1.6, "nodes": 80,
+           "status": "optimal solution found", "stride_time_s": 1.0,
+           "cost_of_transport_j_per_kg_m": 3.45},
+          open("results/sweep/predict_1.6/summary.json", "w"))
+PY
+out=$(/usr/bin/python3 "$src/scripts/validation.py" results)
+check "not U-shaped: 2.0 below 1.6" grep -qF "1.6: 4.20, 2.0: 4.10; 0.8: 3.59, 1.2: 3.28, 1.6: 3.39, 2.0: 3.67 | U-shaped, minimum at 1.0-1.6 m/s | no (provisional) (model's minimum at 1.2 m/s, Ralston's at 1.2; not U-shaped: 2.0 below 1.6) |" <<<"$out"
+rm -r results/sweep/predict_1.6
 
 rm results/track/summary.json
 err=$(/usr/bin/python3 "$src/scripts/validation.py" results 2>&1 >/dev/null)

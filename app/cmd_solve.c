@@ -90,8 +90,7 @@ static const char* kTrackUsageSolver =
     "  --refine N          after a Gauss-Newton or L-BFGS main solve that stopped short (as\n"
     "                      the default one does after --max-iter iterations), up to N Newton\n"
     "                      iterations with the exact Hessian (structured finite differences)\n"
-    "                      from its best iterate (default " GO_STR(GO_REFINE_ITER) ", at most "
-    GO_STR(GO_REFINE_WALL_S) " s; 0: none;\n"
+    "                      from its best iterate (default " GO_STR(GO_REFINE_ITER) "; 0: none;\n"
     "                      summary.json refine). They stop at Ipopt's tests or once the\n"
     "                      objective has settled: " GO_STR(GO_SETTLE_ITER) " of the last "
     "2 x " GO_STR(GO_SETTLE_ITER) " iterations\n"
@@ -109,9 +108,9 @@ static const char* kTrackUsageSolver =
     "                      the refinement\"), --max-iter staying its cap (default "
     GO_STR(GO_HANDOVER_ITER_TRACK) ";\n"
     "                      0: L-BFGS runs to --max-iter)\n"
-    "  --refine-time S     the refinement's wall-clock limit in seconds (default "
-    GO_STR(GO_REFINE_WALL_S) ";\n"
-    "                      --max-time, when given, caps it too)\n"
+    "  --refine-time S     the refinement's wall-clock limit in seconds (default none: it\n"
+    "                      stops at the same iterate on any machine; --max-time, when given,\n"
+    "                      caps it too)\n"
     "  --ipopt KEY=VALUE   extra Ipopt option (repeatable)\n";
 
 typedef struct {

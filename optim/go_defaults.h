@@ -69,12 +69,14 @@
 #define GO_FALLBACK_VIOL 1e-4
 #define GO_MAX_RESTARTS 2
 // exact-Hessian refinement of an L-BFGS tracking solve that stopped short (go_solve.h): at most
-// GO_REFINE_ITER Newton iterations (-) and GO_REFINE_WALL_S seconds of wall clock. From the main
+// GO_REFINE_ITER Newton iterations (-) and GO_REFINE_WALL_S seconds of wall clock (0: no clock,
+// the default: a clock would make the same command stop at another iterate on a slower or busier
+// machine; the iteration cap bounds it: 150 Newton iterations of 5-6 s at N = 80). From the main
 // job's 600-iteration N = 20 solution they reached Ipopt's acceptable level after 78 (238 s,
 // 2 threads), J -3.8 % (docs/BENCHMARKS.md, "Exact-Hessian refinement of the tracking solve");
 // at N = 80 one exact-Hessian iteration costs about 4 times the N = 20 one
 #define GO_REFINE_ITER 150
-#define GO_REFINE_WALL_S 600
+#define GO_REFINE_WALL_S 0
 // the refinement's first phase: GO_REFINE_GN_ITER Gauss-Newton iterations (-); Newton starts
 // where they stop. From the L-BFGS best iterate at N = 80 they lowered J from 2.872 to 2.645 (at
 // a violation of 0.1, which Newton's first 11 iterations brought to 4e-4 at J 2.643), where 124

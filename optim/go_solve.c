@@ -314,9 +314,10 @@ static int refine(run_state* s, const go_ipopt_opts* opts, go_solve_report* rep,
     snprintf(err, (size_t)errsz, "refine: %s", why);
     return -1;
   }
-  // both phases share at most refine_wall_s, or what is left of max_wall_s
-  double budget = p->max_wall_s > 0 ? fmin(p->max_wall_s - res->wall_s, p->refine_wall_s)
-                                    : p->refine_wall_s;
+  // both phases share at most refine_wall_s and what is left of max_wall_s (<= 0: no clock)
+  double budget = p->refine_wall_s > 0 ? p->refine_wall_s : 0.0;
+  if (p->max_wall_s > 0)
+    budget = budget > 0 ? fmin(p->max_wall_s - res->wall_s, budget) : p->max_wall_s - res->wall_s;
   go_ipopt_opts ro = *opts;
   ro.gauss_newton = 0;
   ro.max_wall_s = budget;
@@ -364,8 +365,8 @@ static int refine(run_state* s, const go_ipopt_opts* opts, go_solve_report* rep,
                     !gres->last_restoration &&
                     (gres->status == GO_SOLVE_MAX_ITER || solve_converged(gres));
     if (!gn_usable) memcpy(s->z, s->zb, sizeof(double) * (size_t)s->n);
-    ro.max_wall_s = budget - gres->wall_s;
-    if (gres->status == GO_SOLVE_INTERRUPTED || ro.max_wall_s <= 0) {
+    ro.max_wall_s = budget > 0 ? budget - gres->wall_s : 0.0;
+    if (gres->status == GO_SOLVE_INTERRUPTED || (budget > 0 && ro.max_wall_s <= 0)) {
       // nothing left for Newton: the Gauss-Newton phase stands for the refinement, its best
       // iterate (by the usual ranking) kept when it beats the main solve's
       rep->refine = *gres;

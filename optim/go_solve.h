@@ -91,7 +91,8 @@ typedef struct {
                               // hands over to the refinement at its first iterate from this
                               // iteration on at a violation the polish takes (ipopt.best_viol_tol;
                               // go_ipopt_opts.handover_iter), max_iter staying its cap; 0: off
-  double refine_wall_s;       // refinement's wall-clock cap (s), or less when max_wall_s says
+  double refine_wall_s;       // refinement's wall-clock cap (s; <= 0: none), or less when
+                              // max_wall_s says
   int refine_gn_iter;         // Gauss-Newton iterations before the refinement's Newton ones (-);
                               // 0: none
   int settle_iter;            // the refinement's settled rule (go_ipopt_opts.settle_iter, -)

@@ -71,8 +71,9 @@
 // exact-Hessian refinement of an L-BFGS tracking solve that stopped short (go_solve.h): at most
 // GO_REFINE_ITER Newton iterations (-) and GO_REFINE_WALL_S seconds of wall clock (0: no clock,
 // the default: a clock would make the same command stop at another iterate on a slower or busier
-// machine; the iteration cap bounds it: 150 Newton iterations of 5-6 s at N = 80). From the main
-// job's 600-iteration N = 20 solution they reached Ipopt's acceptable level after 78 (238 s,
+// machine; the iteration cap bounds it: 4.6-6.2 s per Newton iteration at N = 80, docs/
+// BENCHMARKS.md, "The right hip abductors' tendons by a converter rule"). From the main job's
+// 600-iteration N = 20 solution they reached Ipopt's acceptable level after 78 (238 s,
 // 2 threads), J -3.8 % (docs/BENCHMARKS.md, "Exact-Hessian refinement of the tracking solve");
 // at N = 80 one exact-Hessian iteration costs about 4 times the N = 20 one
 #define GO_REFINE_ITER 150

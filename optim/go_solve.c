@@ -315,9 +315,11 @@ static int refine(run_state* s, const go_ipopt_opts* opts, go_solve_report* rep,
     return -1;
   }
   // both phases share at most refine_wall_s and what is left of max_wall_s (<= 0: no clock)
-  double budget = p->refine_wall_s > 0 ? p->refine_wall_s : 0.0;
-  if (p->max_wall_s > 0)
-    budget = budget > 0 ? fmin(p->max_wall_s - res->wall_s, budget) : p->max_wall_s - res->wall_s;
+  double budget = p->refine_wall_s;
+  if (p->max_wall_s > 0) {  // > 0 here: the guard above returned when it was spent
+    double left = p->max_wall_s - res->wall_s;
+    budget = budget > 0 ? fmin(left, budget) : left;
+  }
   go_ipopt_opts ro = *opts;
   ro.gauss_newton = 0;
   ro.max_wall_s = budget;

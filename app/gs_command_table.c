@@ -9,6 +9,7 @@ const gsCommand gs_commands[] = {
     {"simulate", gs_cmd_simulate, "forward simulation with gaitsim's muscles and foot contact"},
     {"inspect", gs_cmd_inspect, "one row per muscle at one instant: lengths, force, metabolics, moment arms"},
     {"balance", gs_cmd_balance, "frontal-plane balance of a gait by inverse dynamics: feet, hips, CoM, momentum"},
+    {"moments", gs_cmd_moments, "net joint moments by inverse dynamics (OpenSim's ID tool) into a .sto"},
     {"work", gs_cmd_work, "mechanical work of a gait per source: muscles, foot contact, knee, limits"},
     {"track", gs_cmd_track, "tracking solve of one stride by direct collocation"},
     {"predict", gs_cmd_predict, "predictive solve at a new speed: minimum cost of transport, free stride time"},

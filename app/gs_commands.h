@@ -21,6 +21,7 @@ int gs_cmd_sweep(int argc, char** argv);
 int gs_cmd_inspect(int argc, char** argv);
 int gs_cmd_balance(int argc, char** argv);
 int gs_cmd_work(int argc, char** argv);
+int gs_cmd_moments(int argc, char** argv);
 int gs_cmd_batch(int argc, char** argv);
 int gs_cmd_batch_status(int argc, char** argv);
 int gs_cmd_render(int argc, char** argv);

@@ -121,9 +121,10 @@ int gs_cmd_report(int argc, char** argv) {
 // exit status (0, 2 usage), GS_EXIT_FAILURE for anything else
 static int run_script(const char* dir, const char* out, const char* staging, const char* trial,
                       const char* track) {
-  // the child's arguments: python3 report.py --out D --into S [--trial T] [--track K] -- DIR;
-  // "--" keeps a DIR that starts with '-' a folder name
-  char* args[13];
+  // the child's arguments: python3 report.py --out D --into S [--gaitsim SELF] [--trial T]
+  // [--track K] -- DIR; "--" keeps a DIR that starts with '-' a folder name. SELF: this binary,
+  // for the joint-moment figure's `gaitsim moments` (a solution folder's report)
+  char* args[15];
   int n = 0;
   args[n++] = (char*)GS_REPORT_PYTHON;
   args[n++] = (char*)GS_REPORT_SCRIPT;
@@ -131,6 +132,13 @@ static int run_script(const char* dir, const char* out, const char* staging, con
   args[n++] = (char*)out;
   args[n++] = (char*)"--into";
   args[n++] = (char*)staging;
+  static char self[4096];
+  ssize_t len = readlink("/proc/self/exe", self, sizeof(self) - 1);
+  if (len > 0) {
+    self[len] = '\0';
+    args[n++] = (char*)"--gaitsim";
+    args[n++] = self;
+  }
   if (trial) {
     args[n++] = (char*)"--trial";
     args[n++] = (char*)trial;

@@ -200,6 +200,20 @@ def inverse_dynamics_work(gaitsim, model, pose_file, grf_file):
     return joints
 
 
+def inverse_dynamics_moments(gaitsim, model, pose_file, grf_file):
+    """(times (s), {column: [values]}): the net joint moments of inverse dynamics from `GAITSIM
+    moments MODEL --pose POSE_FILE --grf GRF_FILE --out F` (app/cmd_moments.c; columns
+    COORD_moment in N m, COORD_force in N), F a temporary file. PrepError naming gaitsim when it
+    fails."""
+    with tempfile.TemporaryDirectory(prefix="gs_moments_") as tmp:
+        out = os.path.join(tmp, "inverse_dynamics.sto")
+        run_gaitsim(gaitsim, ["moments", model, "--pose", pose_file, "--grf", grf_file,
+                              "--out", out])
+        _, labels, rows = read_storage(out)
+    return [r[0] for r in rows], {lab: [r[k] for r in rows] for k, lab in enumerate(labels)
+                                  if k > 0}
+
+
 # Published human figures the mechanical work is compared with (docs/VALIDATION.md,
 # scripts/physiology_figures.py):
 # Zelik & Kuo 2010, J Exp Biol 213:4257, at 1.25 m/s: the soft tissues' negative work per

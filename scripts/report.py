@@ -2,6 +2,7 @@
 """report.py: figures and a table of a gaitsim solution, sweep or batch folder (gaitsim report).
 
 usage: /usr/bin/python3 scripts/report.py DIR [--out D] [--into S] [--trial T] [--track TRACK_DIR]
+                                          [--gaitsim GAITSIM]
 
 Like Lin, Walter & Pandy 2018 (Ann Biomed Eng 46:1216) Fig. 1-3 and Table 1, from a solution
 folder (states.sto, controls.sto, grf.mot, summary.json; knee_contact.sto if present) and the
@@ -19,8 +20,12 @@ coordinates.mot, grf.mot, trial.json, knee_contact.sto):
 - excitations.png: right-leg model excitations (controls.sto) against the EMG envelopes of
   mjmodels/reference/healthy_emg.csv (Falisse et al. 2019, a different, healthy subject), each
   normalised to its peak over the cycle: timing only;
+- joint_moments.png (with --gaitsim, which `gaitsim report` passes, and a model that `gaitsim
+  moments` takes): the net joint moments of inverse dynamics (N m/kg) at both hips (flexion,
+  adduction), knees and ankles, the solution (its states.sto under its grf.mot) against the
+  measured gait (the trial's coordinates.mot under its plates), both by `GAITSIM moments`;
 - report.md: the RMS errors of summary.json beside the paper's participant-2 values (Table 1),
-  the solve facts, and links to the figures.
+  the solve facts, the joint moments' RMS differences, and links to the figures.
 Body weight: summary.json body_weight_n (the model's mass x g, as the solve's RMS errors), else
 trial.json mass_kg x 9.80665 N.
 
@@ -71,7 +76,8 @@ import signal
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from gs_scriptlib import PrepError, read_json, read_storage, write_atomic  # noqa: E402
+from gs_scriptlib import (PrepError, inverse_dynamics_moments, read_json,  # noqa: E402
+                          read_storage, write_atomic)
 
 SOURCE_DIR = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 DEFAULT_TRIAL = os.path.join(SOURCE_DIR, "mjmodels", "trials", "jw_ngait_og5")
@@ -339,7 +345,38 @@ def load(args):
         d["emg"].append((ch, pct, mean, std, [(m, d["controls"].col(m)) for m in present]))
     if not d["emg"]:
         raise PrepError(d["controls"].path, "no right-leg muscle matching an EMG channel")
+    d["moments"], d["moments_note"] = joint_moments(args.gaitsim, summary, sol, trial)
     return d
+
+
+# the joint-moment panels: (coordinate, title)
+MOMENT_PANELS = [("hip_flexion", "hip flexion R"), ("hip_adduction", "hip adduction R"),
+                 ("knee_flexion", "knee extension R"), ("ankle_angle", "ankle dorsiflexion R"),
+                 ("hip_flexion_l", "hip flexion L"), ("hip_adduction_l", "hip adduction L"),
+                 ("knee_flexion_l", "knee extension L"), ("ankle_angle_l", "ankle dorsiflexion L")]
+
+
+def joint_moments(gaitsim, summary, sol, trial):
+    """(moments, note): the net joint moments of the solution and of the measured gait by
+    `GAITSIM moments` ({"model": (times, columns), "measured": (...)}), or (None, why not) when
+    there is no --gaitsim, no model in summary.json, or the command does not take the model (the
+    planar model has no hip_adduction)."""
+    if not gaitsim:
+        return None, "no gaitsim binary given (--gaitsim)"
+    model = summary.get("model")
+    if not isinstance(model, str) or not os.path.isfile(model):
+        return None, "summary.json names no model file"
+    try:
+        solved = inverse_dynamics_moments(gaitsim, model, os.path.join(sol, "states.sto"),
+                                          os.path.join(sol, "grf.mot"))
+        measured = inverse_dynamics_moments(gaitsim, model, os.path.join(trial, "coordinates.mot"),
+                                            os.path.join(trial, "grf.mot"))
+    except PrepError as e:
+        return None, f"`gaitsim moments` on this solution: {e.reason}"
+    have = [c for c, _ in MOMENT_PANELS if c + "_moment" in solved[1] and c + "_moment" in measured[1]]
+    if not have:
+        return None, "the model has none of the hip, knee and ankle coordinates"
+    return {"model": solved, "measured": measured, "coordinates": have}, None
 
 
 def axes_style(ax, xlabel, ylabel):
@@ -443,6 +480,36 @@ def fig_knee(d, plt):
         ax.legend(fontsize=6, loc="best")
     note = "" if d["meas_knee"] is not None else " (no measured knee_contact.sto in the trial)"
     fig.suptitle(f"Knee contact force, BW = {d['mass']:.2f} kg x g{note}", fontsize=9)
+    return png_bytes(fig, plt)
+
+
+def moment_rms(d, c):
+    """RMS difference (N m) of the solution's c moment from the measured one, the measured curve
+    interpolated at the solution's times (both start at the stride's right heel strike)."""
+    import numpy as np
+    tm, meas = d["moments"]["measured"]
+    ts, model = d["moments"]["model"]
+    m = np.interp(ts, tm, meas[c + "_moment"])
+    return float(np.sqrt(np.mean((np.asarray(model[c + "_moment"]) - m) ** 2)))
+
+
+def fig_moments(d, plt):
+    import numpy as np
+    have = d["moments"]["coordinates"]
+    fig, axes = panel_grid(plt, len(have), 4, 2.5, 2.0, 0.6)
+    titles = dict(MOMENT_PANELS)
+    for ax, c in zip(axes, have):
+        for key, style, colour, label in (("measured", "--", "0.2", "measured gait"),
+                                          ("model", "-", "tab:green", "model")):
+            t, cols = d["moments"][key]
+            t = np.asarray(t)
+            ax.plot(100.0 * (t - t[0]) / (t[-1] - t[0]), np.asarray(cols[c + "_moment"]) / d["mass"],
+                    color=colour, linestyle=style, linewidth=1.2, label=label)
+        ax.set_title(f"{titles[c]}, RMS diff {moment_rms(d, c):.1f} N m", fontsize=7)
+        panel_style(ax, "% gait cycle", "N m/kg")
+    axes[0].legend(fontsize=6, loc="best")
+    fig.suptitle("Net joint moments by inverse dynamics (gaitsim moments): model (its states and "
+                 "GRF) vs measured gait (the trial's coordinates and plates)", fontsize=9)
     return png_bytes(fig, plt)
 
 
@@ -551,6 +618,11 @@ def report_md(d, figures):
                                "only)."),
         "excitations.png": "Right-leg excitations vs EMG envelopes of a healthy subject (Falisse et "
                            "al. 2019), each normalised to its peak: timing only.",
+        "joint_moments.png": "Net joint moments by inverse dynamics, N m per kg of body mass "
+                             "(`gaitsim moments`): the solution's states under its own GRF vs the "
+                             "measured coordinates under the plates; positive in each coordinate's "
+                             "positive direction (hip flexion and adduction, knee extension, ankle "
+                             "dorsiflexion).",
     }
     for name in figures:
         lines += [f"![{name}]({name})", "", captions[name], ""]
@@ -559,6 +631,13 @@ def report_md(d, figures):
     if d["emg_skipped"]:
         lines += ["EMG channels without a model muscle in controls.sto: "
                   + ", ".join(d["emg_skipped"]) + ".", ""]
+    if d.get("moments") is not None:
+        lines += ["## Joint moments against the measured gait", "",
+                  "| coordinate | RMS difference (N m) |", "|---|---|"]
+        lines += [f"| {c} | {moment_rms(d, c):.1f} |" for c in d["moments"]["coordinates"]]
+        lines.append("")
+    else:
+        lines += [f"No joint-moment figure: {d.get('moments_note')}.", ""]
     return "\n".join(lines)
 
 
@@ -1191,6 +1270,9 @@ def main(argv=None):
                     help="write into this folder instead of --out (gaitsim report: its temporary "
                          "folder, renamed to --out when this succeeds); messages name --out")
     ap.add_argument("--trial", default=None, help="measured trial folder (default: summary.json trial)")
+    ap.add_argument("--gaitsim", default=None,
+                    help="solution folder only: the gaitsim binary, for the joint-moment figure "
+                         "(`gaitsim report` passes its own)")
     ap.add_argument("--track", default=None,
                     help="sweep folder only: the tracking solution (default: the predictions' guess)")
     args = ap.parse_args(argv)
@@ -1214,6 +1296,8 @@ def main(argv=None):
             if d["knee"] is not None:
                 figures["knee_contact.png"] = fig_knee(d, plt)
             figures["excitations.png"] = fig_excitations(d, plt)
+            if d["moments"] is not None:
+                figures["joint_moments.png"] = fig_moments(d, plt)
             text = report_md(d, list(figures))
         for name, data in list(figures.items()) + [("report.md", text)]:
             try:

@@ -17,8 +17,11 @@ mechanical work of the tracking solution and of each prediction (`GAITSIM work M
 DIR/states.sto --joints`, MODEL from summary.json) against published human figures: the foot
 contact's negative and positive work per collision against the soft tissues' (Zelik & Kuo 2010,
 J Exp Biol 213:4257), the knee's share of each leg's sagittal negative work in stance and the
-ankle's of the positive (Montgomery & Grabowski 2018, R Soc Open Sci 5:180550). Exit 1 with one
-line naming the file when an input is missing.
+ankle's of the positive (Montgomery & Grabowski 2018, R Soc Open Sci 5:180550); and the
+tracking solution's net joint moments against the measured gait's, both by inverse dynamics
+(`GAITSIM moments MODEL --pose P --grf G --out F`: the trial's coordinates.mot and plates, the
+solution's states.sto and grf.mot). Exit 1 with one line naming the file when an input is
+missing.
 """
 import glob
 import math
@@ -28,7 +31,7 @@ import sys
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 from gs_scriptlib import (ANKLE_POSITIVE_SHARE, KNEE_NEGATIVE_SHARE,  # noqa: E402
                           SOFT_TISSUE_COLLISION_J, SOFT_TISSUE_REBOUND_J, PrepError,
-                          inverse_dynamics_work, mechanical_work, read_json, read_storage,
+                          inverse_dynamics_moments, inverse_dynamics_work, mechanical_work, read_json, read_storage,
                           results_and_gaitsim, stance_work)
 from report import PAPER_MEASURED_STRIDE_TIME, PAPER_STRIDE_TIME, TABLE1  # noqa: E402
 
@@ -315,6 +318,75 @@ def mechanical(gaitsim, folders):
     print()
 
 
+# the coordinates of the joint-moment table, with the OpenSim ID column each carries
+MOMENT_COORDINATES = ("hip_flexion", "hip_adduction", "hip_rotation", "knee_flexion",
+                      "knee_adduction", "ankle_angle", "subtalar_angle", "hip_flexion_l",
+                      "hip_adduction_l", "hip_rotation_l", "knee_flexion_l", "ankle_angle_l",
+                      "subtalar_angle_l", "lumbar_extension", "lumbar_bending", "lumbar_rotation")
+
+
+def interp(x, xs, ys):
+    """ys at x by linear interpolation in the increasing xs, clamped at the ends."""
+    if x <= xs[0]:
+        return ys[0]
+    if x >= xs[-1]:
+        return ys[-1]
+    lo, hi = 0, len(xs) - 1
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        lo, hi = (mid, hi) if xs[mid] <= x else (lo, mid)
+    w = (x - xs[lo]) / (xs[hi] - xs[lo])
+    return ys[lo] + w * (ys[hi] - ys[lo])
+
+
+def joint_moments(gaitsim, track):
+    """The joint-moment section: the tracking solution's net joint moments against the measured
+    gait's, both by inverse dynamics with one command (`gaitsim moments MODEL --pose P --grf G`,
+    app/cmd_moments.c): the trial's coordinates.mot under its plates, the solution's states.sto
+    under its own grf.mot; the measured curve interpolated at the solution's node times."""
+    s = read_json(os.path.join(track, "summary.json"))
+    trial, model = s.get("trial"), s.get("model")
+    if not trial or not model:
+        raise PrepError(os.path.join(track, "summary.json"), "no trial or model")
+    try:
+        tm, meas = inverse_dynamics_moments(gaitsim, model, os.path.join(trial, "coordinates.mot"),
+                                            os.path.join(trial, "grf.mot"))
+        ts, sol = inverse_dynamics_moments(gaitsim, model, os.path.join(track, "states.sto"),
+                                           os.path.join(track, "grf.mot"))
+    except PrepError as e:
+        raise PrepError(track, f"gaitsim {e.reason}")
+    print("## Joint moments against the measured gait\n")
+    print("The tracking solution's net joint moments (what its muscles and passive structures "
+          "supply) against those of the gait JW walked, both by inverse dynamics with one command "
+          "(`gaitsim moments MODEL --pose TRIAL/coordinates.mot --grf TRIAL/grf.mot --out F`, and "
+          "`--pose track/states.sto --grf track/grf.mot` for the solution), so the model and the "
+          "method are the same on both sides. Not a target of the issues: a check on where the "
+          "solution's muscles work differently from JW's. A moment is positive in its "
+          "coordinate's positive direction (hip flexion, adduction and internal rotation, knee "
+          "extension, ankle dorsiflexion).\n")
+    row(["coordinate", "RMS difference (N m)", "measured range (N m)", "solution range (N m)",
+         "measured mean / solution mean (N m)"])
+    row(["---"] * 5)
+    for c in MOMENT_COORDINATES:
+        col = c + "_moment"
+        if col not in meas or col not in sol:
+            continue
+        m = [interp(t, tm, meas[col]) for t in ts]
+        v = sol[col]
+        rms = math.sqrt(sum((a - b) ** 2 for a, b in zip(v, m)) / len(v))
+        row([c, f"{rms:.1f}", f"{min(m):.1f} ... {max(m):.1f}", f"{min(v):.1f} ... {max(v):.1f}",
+             f"{sum(m) / len(m):.1f} / {sum(v) / len(v):.1f}"])
+    res = []
+    for moments in (meas, sol):
+        f = [math.sqrt(sum(moments[f"pelvis_t{a}_force"][i] ** 2 for a in "xyz"))
+             for i in range(len(moments["pelvis_tx_force"]))]
+        res.append(math.sqrt(sum(x * x for x in f) / len(f)))
+    print(f"\nPelvis residual force, RMS: measured gait {res[0]:.1f} N (the plates' and the "
+          f"markers' disagreement with the model's masses), solution {res[1]:.1f} N (its "
+          "accelerations by central differences of the nodes' speeds; its dynamics hold at the "
+          "nodes).\n")
+
+
 def main(argv):
     parsed = results_and_gaitsim(argv, "validation", __doc__)
     if isinstance(parsed, int):
@@ -341,6 +413,7 @@ def main(argv):
             mechanical(gaitsim, [os.path.join(results, "track")] + sorted(
                 preds, key=lambda p: read_json(os.path.join(p, "summary.json"))
                 .get("speed_target_mps", 0)))
+            joint_moments(gaitsim, os.path.join(results, "track"))
         print("## References\n")
         print("- Lin Y-C, Walter JP, Pandy MG (2018). Predictive simulations of neuromuscular "
               "coordination and joint-contact loading in human gait. Ann Biomed Eng 46:1216: "

@@ -16,7 +16,9 @@
 # `work` table gives each solution's foot contact per collision (-15.0 / +2.0 J) and the right
 # leg's knee share of the stance negative work (0.30) and ankle share of the positive (0.59), no
 # left leg ("-"), its `work --grf` the measured trial's row first (0.50 / 0.50), and the two
-# references; a missing binary and a missing track summary exit 1
+# references; its `moments` files (hip_adduction -20 N m on the trial's pose, -1 N m on the
+# solution's; pelvis forces 50 and 5 N) the joint-moment row (RMS difference 19.0 N m) and the
+# residuals; a missing binary and a missing track summary exit 1
 # with one line naming them.
 # usage: validation.sh GAITSIM SOURCE_DIR
 set -u
@@ -96,6 +98,16 @@ for p in ["results/track/summary.json"] + glob.glob("results/sweep/*/summary.jso
 PY
 cat >fake_gaitsim <<'SH'
 #!/usr/bin/env bash
+if [ "$1" = moments ]; then
+  # the trial's pose: hip_adduction -20 N m, pelvis force (30, 40, 0) N; a solution's: -1 N m,
+  # (3, 4, 0) N
+  case "$4" in *coordinates.mot) m=-20 f="30 40 0" ;; *) m=-1 f="3 4 0" ;; esac
+  out=$8
+  { printf 'inverse_dynamics\nversion=1\nnRows=3\nnColumns=5\ninDegrees=no\nendheader\n'
+    printf 'time\tpelvis_tx_force\tpelvis_ty_force\tpelvis_tz_force\thip_adduction_moment\n'
+    for t in 0 0.5 1; do printf '%s\t%s\t%s\t%s\t%s\n' $t $f $m; done; } >"$out"
+  exit 0
+fi
 [ "$1" = work ] || exit 2
 if [ "$5" = --grf ]; then
   echo "| coordinate | positive | negative | in stance: positive | negative |"
@@ -123,6 +135,11 @@ check "--gaitsim: the measured row" grep -qxF \
   "| measured (the trial, inverse dynamics: net joint work) | - | 0.50 / - | 0.50 / - |" <<<"$out"
 check "--gaitsim: tracking row" grep -qxF "| tracking | -15.0 / 2.0 | 0.30 / - | 0.59 / - |" <<<"$out"
 check "--gaitsim: a row per prediction, by speed" test "$(grep -c "^| prediction [0-9.]* m/s | -15.0 / 2.0 |" <<<"$out")" -eq 3
+check "--gaitsim: the joint-moment row" grep -qxF \
+  "| hip_adduction | 19.0 | -20.0 ... -20.0 | -1.0 ... -1.0 | -20.0 / -1.0 |" <<<"$out"
+check "--gaitsim: the pelvis residuals" grep -qF \
+  "Pelvis residual force, RMS: measured gait 50.0 N" <<<"$out"
+check "--gaitsim: the solution's residual" grep -qF "solution 5.0 N" <<<"$out"
 check "--gaitsim: Zelik & Kuo and Montgomery & Grabowski cited" \
   test "$(grep -cE "^- (Zelik KE, Kuo AD \(2010\)|Montgomery JR, Grabowski AM \(2018\))" <<<"$out")" -eq 2
 err=$(/usr/bin/python3 "$src/scripts/validation.py" results --gaitsim ./no_such_binary 2>&1 >/dev/null)

@@ -147,21 +147,7 @@ int gs_cmd_moments(int argc, char** argv) {
     fprintf(stderr, "gaitsim: %s: %s\n", path, err);
     goto done;
   }
-  if (gs_app_read_table(m, pose, &t) != 0 || gs_app_require_coordinates(m, &t, pose) != 0)
-    goto done;
-  if (gs_state_map(m, &t, &map, err, sizeof(err)) != 0) {
-    fprintf(stderr, "gaitsim: %s: %s\n", pose, err);
-    goto done;
-  }
-  if (t.nrow < 3) {
-    fprintf(stderr, "gaitsim: %s: %d rows; the differences need at least 3\n", pose, t.nrow);
-    goto done;
-  }
-  if (gs_app_read_table(m, grf, &g) != 0) goto done;
-  if (gs_balance_grf_columns(&g, col, err, sizeof(err)) != 0) {
-    fprintf(stderr, "gaitsim: %s: %s\n", grf, err);
-    goto done;
-  }
+  if (gs_app_read_pose_and_loads(m, pose, grf, &t, &map, &g, col) != 0) goto done;
   ncol = moment_columns(m, col_of, labels);
   if (ncol < 0 || gs_table_create(&res, t.nrow, ncol, (const char* const*)labels, err,
                                   sizeof(err)) != 0) {

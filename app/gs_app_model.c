@@ -11,6 +11,7 @@
 
 #include <cjson/cJSON.h>
 
+#include "callbacks/gs_balance.h"
 #include "callbacks/gs_coupling.h"
 #include "callbacks/gs_mujoco.h"
 #include "callbacks/gs_physics.h"
@@ -251,6 +252,27 @@ int gs_app_check_pose_file(const mjModel* m, const char* path) {
 const char* gs_app_model_for_solution(const char* dir, const char* given, char* buf, int n) {
   if (given) return given;
   return gs_app_solution_model(dir, buf, n) ? buf : GS_DEFAULT_MODEL;
+}
+
+int gs_app_read_pose_and_loads(const mjModel* m, const char* pose, const char* grf, gsTable* t,
+                               gsStateMap* map, gsTable* g, int col[GS_GRF_NCOL]) {
+  char err[512];
+  if (gs_app_read_table(m, pose, t) != 0 || gs_app_require_coordinates(m, t, pose) != 0)
+    return -1;
+  if (gs_state_map(m, t, map, err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s: %s\n", pose, err);
+    return -1;
+  }
+  if (t->nrow < 3) {
+    fprintf(stderr, "gaitsim: %s: %d rows; the differences need at least 3\n", pose, t->nrow);
+    return -1;
+  }
+  if (gs_app_read_table(m, grf, g) != 0) return -1;
+  if (gs_balance_grf_columns(g, col, err, sizeof(err)) != 0) {
+    fprintf(stderr, "gaitsim: %s: %s\n", grf, err);
+    return -1;
+  }
+  return 0;
 }
 
 int gs_app_pose_kinematics(const mjModel* m, mjData* d, const gsTable* t,

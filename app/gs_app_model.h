@@ -53,6 +53,14 @@ int gs_app_require_coordinates(const mjModel* m, const gsTable* t, const char* p
 // Read the pose or states file at path and check it with gs_app_require_coordinates. Prints one
 // line and returns -1 otherwise.
 int gs_app_check_pose_file(const mjModel* m, const char* path);
+// The inputs of an inverse dynamics under measured or solved ground reactions (gaitsim balance,
+// moments): the pose file (a states.sto or coordinates.mot with every coordinate, at least 3 rows
+// for the differences) into t and its column map into map, and the ground reactions (OpenSim
+// ExternalLoads columns, gs_balance_grf_columns) into g with their columns in col. Prints one line
+// "gaitsim: FILE: reason" and returns -1 otherwise (the tables and map stay the caller's to free).
+int gs_app_read_pose_and_loads(const mjModel* m, const char* pose, const char* grf, gsTable* t,
+                               gsStateMap* map, gsTable* g, int col[GS_GRF_NCOL]);
+
 // Every row's qpos, qvel and qacc (n x nq, n x nv, n x nv; n = t->nrow >= 3) from table t
 // (mapped by map, in radians) for inverse dynamics: the speeds from the file when it has every
 // one, else by central differences of the rows (one-sided at the ends), the accelerations always

@@ -485,11 +485,14 @@ def fig_knee(d, plt):
 
 def moment_rms(d, c):
     """RMS difference (N m) of the solution's c moment from the measured one, the measured curve
-    interpolated at the solution's times (both start at the stride's right heel strike)."""
+    interpolated at the solution's phases of the stride (both run from right heel strike to right
+    heel strike, so a prediction at another stride time is compared phase by phase)."""
     import numpy as np
     tm, meas = d["moments"]["measured"]
     ts, model = d["moments"]["model"]
-    m = np.interp(ts, tm, meas[c + "_moment"])
+    tm, ts = np.asarray(tm), np.asarray(ts)
+    m = np.interp((ts - ts[0]) / (ts[-1] - ts[0]), (tm - tm[0]) / (tm[-1] - tm[0]),
+                  meas[c + "_moment"])
     return float(np.sqrt(np.mean((np.asarray(model[c + "_moment"]) - m) ** 2)))
 
 
